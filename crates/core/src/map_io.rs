@@ -1,0 +1,909 @@
+//! ROS map_server maps: YAML metadata plus a PGM (P5 or P2) or PNG image, read and written.
+//!
+//! Reading follows map_server's `loadMapFromFile`: a pixel's occupancy is `p = (255 - v) / 255`
+//! (`v / 255` when `negate` is set); `trinary` mode makes `p > occupied_thresh` occupied,
+//! `p < free_thresh` free and the rest unknown; `scale` keeps the in-between values; `raw` takes the
+//! pixel value itself as the ROS occupancy (0..100, anything else unknown). Occupancies become log-odds
+//! clamped to ±[`ROS_LOGODDS_LIMIT`], so a map read back from disk holds exactly −2, 0 or +2 per cell.
+//!
+//! The YAML reader handles the flat subset map_server files use: `key: value` lines, `#` comments and a
+//! flow list for `origin`. Errors name the file, the line and the field.
+
+use crate::grid::{CellState, GridError, MAX_CELLS, OccupancyGrid};
+use crate::pose::{Pose2, pose};
+use std::fmt::Write as _;
+use std::io::Write as _;
+use std::path::{Path, PathBuf};
+
+/// Log-odds given to a definitely occupied (+) or free (−) cell read from a ROS map: p ≈ 0.88 / 0.12.
+pub const ROS_LOGODDS_LIMIT: f32 = 2.0;
+
+/// PGM value written for occupied cells.
+pub const PGM_OCCUPIED: u8 = 0;
+/// PGM value written for free cells.
+pub const PGM_FREE: u8 = 254;
+/// PGM value written for unknown cells.
+pub const PGM_UNKNOWN: u8 = 205;
+
+/// How map_server interprets pixel values.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MapMode {
+    /// Occupied, free or unknown by the two thresholds.
+    Trinary,
+    /// Like trinary, with in-between values kept as a graded occupancy.
+    Scale,
+    /// The pixel value is the occupancy 0..100; others are unknown.
+    Raw,
+}
+
+/// The metadata of a map_server YAML file.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MapYaml {
+    /// Image path as written in the file (relative paths are relative to the YAML file).
+    pub image: String,
+    /// Metres per pixel.
+    pub resolution: f64,
+    /// Pose of the lower-left pixel's outer corner: x, y, yaw.
+    pub origin: [f64; 3],
+    /// Whether white means occupied.
+    pub negate: bool,
+    /// Occupancy above which a pixel is occupied.
+    pub occupied_thresh: f64,
+    /// Occupancy below which a pixel is free.
+    pub free_thresh: f64,
+    /// Interpretation of pixel values.
+    pub mode: MapMode,
+}
+
+/// Everything that can go wrong reading or writing a map; each names the file.
+#[derive(Debug, thiserror::Error)]
+pub enum MapIoError {
+    /// The file could not be read or written.
+    #[error("{path}: {source}")]
+    Io {
+        /// File at fault.
+        path: PathBuf,
+        /// Underlying error.
+        source: std::io::Error,
+    },
+    /// A YAML line could not be understood.
+    #[error("{path}:{line}: {message}")]
+    Yaml {
+        /// File at fault.
+        path: PathBuf,
+        /// 1-based line number.
+        line: usize,
+        /// What is wrong.
+        message: String,
+    },
+    /// A field has a value that is not allowed.
+    #[error("{path}:{line}: field `{field}`: {message}")]
+    BadField {
+        /// File at fault.
+        path: PathBuf,
+        /// 1-based line number.
+        line: usize,
+        /// Field name.
+        field: &'static str,
+        /// What is wrong.
+        message: String,
+    },
+    /// A required field is absent.
+    #[error("{path}: missing required field `{field}`")]
+    MissingField {
+        /// File at fault.
+        path: PathBuf,
+        /// Field name.
+        field: &'static str,
+    },
+    /// The image is not a valid PGM.
+    #[error("{path}: not a valid PGM image: {message}")]
+    Pgm {
+        /// File at fault.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
+    /// The image could not be decoded.
+    #[error("{path}: cannot decode image: {message}")]
+    Image {
+        /// File at fault.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
+    /// The image is larger than this program accepts.
+    #[error("{path}: image of {width}x{height} pixels exceeds the limit of {MAX_CELLS} cells")]
+    TooLarge {
+        /// File at fault.
+        path: PathBuf,
+        /// Width claimed.
+        width: usize,
+        /// Height claimed.
+        height: usize,
+    },
+    /// The grid could not be built.
+    #[error("{path}: {source}")]
+    Grid {
+        /// File at fault.
+        path: PathBuf,
+        /// Underlying error.
+        source: GridError,
+    },
+}
+
+fn io_err(path: &Path) -> impl FnOnce(std::io::Error) -> MapIoError + '_ {
+    move |source| MapIoError::Io {
+        path: path.to_path_buf(),
+        source,
+    }
+}
+
+/// A grey image with 8-bit pixels, row 0 at the top, as stored on disk.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct GreyImage {
+    /// Width in pixels.
+    pub width: usize,
+    /// Height in pixels.
+    pub height: usize,
+    /// Pixels, row-major from the top row.
+    pub pixels: Vec<u8>,
+}
+
+/// Reads a map_server YAML file and the image it names.
+pub fn read_ros_map(yaml_path: &Path) -> Result<OccupancyGrid, MapIoError> {
+    let text = std::fs::read_to_string(yaml_path).map_err(io_err(yaml_path))?;
+    let meta = parse_map_yaml(&text, yaml_path)?;
+    let image_path = resolve_image_path(yaml_path, &meta.image);
+    let img = read_grey_image(&image_path)?;
+    grid_from_image(&img, &meta).map_err(|source| MapIoError::Grid {
+        path: yaml_path.to_path_buf(),
+        source,
+    })
+}
+
+/// Resolves the YAML's `image` field against the YAML file's folder.
+pub fn resolve_image_path(yaml_path: &Path, image: &str) -> PathBuf {
+    let p = Path::new(image);
+    if p.is_absolute() {
+        p.to_path_buf()
+    } else {
+        yaml_path.parent().unwrap_or(Path::new(".")).join(p)
+    }
+}
+
+/// Builds a grid from an image and its metadata, as map_server does.
+pub fn grid_from_image(img: &GreyImage, meta: &MapYaml) -> Result<OccupancyGrid, GridError> {
+    let (w, h) = (img.width, img.height);
+    let mut cells = vec![0.0f32; w * h];
+    let (occ, free) = (meta.occupied_thresh, meta.free_thresh);
+    for row in 0..h {
+        let iy = h - 1 - row;
+        for ix in 0..w {
+            let v = img.pixels[row * w + ix];
+            let ros: i32 = match meta.mode {
+                MapMode::Raw => {
+                    if v <= 100 {
+                        v as i32
+                    } else {
+                        -1
+                    }
+                }
+                MapMode::Trinary | MapMode::Scale => {
+                    let p = if meta.negate {
+                        v as f64 / 255.0
+                    } else {
+                        (255.0 - v as f64) / 255.0
+                    };
+                    if p > occ {
+                        100
+                    } else if p < free {
+                        0
+                    } else if meta.mode == MapMode::Scale {
+                        (99.0 * (p - free) / (occ - free)) as i32
+                    } else {
+                        -1
+                    }
+                }
+            };
+            cells[iy * w + ix] = ros_to_log_odds(ros);
+        }
+    }
+    OccupancyGrid::from_cells(
+        w,
+        h,
+        meta.resolution,
+        pose(meta.origin[0], meta.origin[1], meta.origin[2]),
+        cells,
+    )
+}
+
+/// Log-odds of a ROS occupancy value (−1 unknown, 0..100).
+pub fn ros_to_log_odds(v: i32) -> f32 {
+    match v {
+        v if !(0..=100).contains(&v) => 0.0,
+        0 => -ROS_LOGODDS_LIMIT,
+        100 => ROS_LOGODDS_LIMIT,
+        v => {
+            let p = v as f32 / 100.0;
+            (p / (1.0 - p))
+                .ln()
+                .clamp(-ROS_LOGODDS_LIMIT, ROS_LOGODDS_LIMIT)
+        }
+    }
+}
+
+/// Parses the text of a map_server YAML file; `path` only names the file in errors.
+pub fn parse_map_yaml(text: &str, path: &Path) -> Result<MapYaml, MapIoError> {
+    let yaml_err = |line: usize, message: String| MapIoError::Yaml {
+        path: path.to_path_buf(),
+        line,
+        message,
+    };
+    let bad = |line: usize, field: &'static str, message: String| MapIoError::BadField {
+        path: path.to_path_buf(),
+        line,
+        field,
+        message,
+    };
+    let mut image: Option<String> = None;
+    let mut resolution: Option<(usize, f64)> = None;
+    let mut origin: Option<[f64; 3]> = None;
+    let mut negate = false;
+    let mut occupied_thresh = 0.65;
+    let mut free_thresh = 0.196;
+    let mut thresh_line = 0;
+    let mut mode = MapMode::Trinary;
+    let mut seen: Vec<String> = Vec::new();
+    for (i, raw) in text.lines().enumerate() {
+        let line_no = i + 1;
+        let line = strip_comment(raw).trim();
+        if line.is_empty() || line == "---" {
+            continue;
+        }
+        let Some((key, value)) = line.split_once(':') else {
+            return Err(yaml_err(
+                line_no,
+                format!("expected `key: value`, found `{line}`"),
+            ));
+        };
+        let key = key.trim();
+        let value = unquote(value.trim());
+        if seen.iter().any(|k| k == key) {
+            return Err(yaml_err(line_no, format!("field `{key}` appears twice")));
+        }
+        seen.push(key.to_string());
+        let number = |field: &'static str| -> Result<f64, MapIoError> {
+            value
+                .parse::<f64>()
+                .ok()
+                .filter(|v| v.is_finite())
+                .ok_or_else(|| {
+                    bad(
+                        line_no,
+                        field,
+                        format!("expected a finite number, found `{value}`"),
+                    )
+                })
+        };
+        match key {
+            "image" => {
+                if value.is_empty() {
+                    return Err(bad(line_no, "image", "empty image path".into()));
+                }
+                image = Some(value.to_string());
+            }
+            "resolution" => {
+                let r = number("resolution")?;
+                if r <= 0.0 {
+                    return Err(bad(
+                        line_no,
+                        "resolution",
+                        format!("must be positive, found {r}"),
+                    ));
+                }
+                resolution = Some((line_no, r));
+            }
+            "origin" => {
+                let inner = value
+                    .strip_prefix('[')
+                    .and_then(|v| v.strip_suffix(']'))
+                    .ok_or_else(|| {
+                        bad(
+                            line_no,
+                            "origin",
+                            format!("expected `[x, y, yaw]`, found `{value}`"),
+                        )
+                    })?;
+                let parts: Vec<&str> = inner.split(',').map(str::trim).collect();
+                if parts.len() != 3 {
+                    return Err(bad(
+                        line_no,
+                        "origin",
+                        format!("expected 3 numbers, found {}", parts.len()),
+                    ));
+                }
+                let mut o = [0.0; 3];
+                for (k, p) in parts.iter().enumerate() {
+                    o[k] = p
+                        .parse::<f64>()
+                        .ok()
+                        .filter(|v| v.is_finite())
+                        .ok_or_else(|| {
+                            bad(line_no, "origin", format!("`{p}` is not a finite number"))
+                        })?;
+                }
+                origin = Some(o);
+            }
+            "negate" => {
+                negate = match value {
+                    "0" | "false" | "False" => false,
+                    "1" | "true" | "True" => true,
+                    _ => {
+                        return Err(bad(
+                            line_no,
+                            "negate",
+                            format!("expected 0 or 1, found `{value}`"),
+                        ));
+                    }
+                }
+            }
+            "occupied_thresh" => {
+                occupied_thresh = number("occupied_thresh")?;
+                thresh_line = line_no;
+            }
+            "free_thresh" => {
+                free_thresh = number("free_thresh")?;
+                thresh_line = thresh_line.max(line_no);
+            }
+            "mode" => {
+                mode = match value {
+                    "trinary" => MapMode::Trinary,
+                    "scale" => MapMode::Scale,
+                    "raw" => MapMode::Raw,
+                    _ => {
+                        return Err(bad(
+                            line_no,
+                            "mode",
+                            format!("expected trinary, scale or raw, found `{value}`"),
+                        ));
+                    }
+                }
+            }
+            _ => {} // map_server ignores fields it does not know; so do we.
+        }
+    }
+    if !(0.0..=1.0).contains(&free_thresh)
+        || !(0.0..=1.0).contains(&occupied_thresh)
+        || free_thresh >= occupied_thresh
+    {
+        return Err(bad(
+            thresh_line,
+            "free_thresh",
+            format!(
+                "need 0 <= free_thresh < occupied_thresh <= 1, found {free_thresh} and {occupied_thresh}"
+            ),
+        ));
+    }
+    let missing = |field| MapIoError::MissingField {
+        path: path.to_path_buf(),
+        field,
+    };
+    Ok(MapYaml {
+        image: image.ok_or_else(|| missing("image"))?,
+        resolution: resolution.ok_or_else(|| missing("resolution"))?.1,
+        origin: origin.ok_or_else(|| missing("origin"))?,
+        negate,
+        occupied_thresh,
+        free_thresh,
+        mode,
+    })
+}
+
+fn strip_comment(line: &str) -> &str {
+    let mut in_quote: Option<char> = None;
+    for (i, c) in line.char_indices() {
+        match (c, in_quote) {
+            ('"' | '\'', None) => in_quote = Some(c),
+            (q, Some(open)) if q == open => in_quote = None,
+            ('#', None) if i == 0 || line[..i].ends_with(char::is_whitespace) => return &line[..i],
+            _ => {}
+        }
+    }
+    line
+}
+
+fn unquote(v: &str) -> &str {
+    for q in ['"', '\''] {
+        if let Some(inner) = v.strip_prefix(q).and_then(|s| s.strip_suffix(q)) {
+            return inner;
+        }
+    }
+    v
+}
+
+/// Reads a grey image: PGM (P5 binary or P2 ASCII, any maxval) by our own parser, anything else (PNG) with
+/// the `image` crate. Colour images are averaged to grey as map_server does; dimensions are checked
+/// against [`MAX_CELLS`] before pixels are allocated.
+pub fn read_grey_image(path: &Path) -> Result<GreyImage, MapIoError> {
+    let bytes = std::fs::read(path).map_err(io_err(path))?;
+    if bytes.first() == Some(&b'P') {
+        return parse_pgm(&bytes, path);
+    }
+    let reader = image::ImageReader::new(std::io::Cursor::new(&bytes))
+        .with_guessed_format()
+        .map_err(io_err(path))?;
+    let (w, h) = reader.into_dimensions().map_err(|e| MapIoError::Image {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    })?;
+    let (w, h) = (w as usize, h as usize);
+    if w.saturating_mul(h) > MAX_CELLS {
+        return Err(MapIoError::TooLarge {
+            path: path.to_path_buf(),
+            width: w,
+            height: h,
+        });
+    }
+    let img = image::ImageReader::new(std::io::Cursor::new(&bytes))
+        .with_guessed_format()
+        .map_err(io_err(path))?
+        .decode()
+        .map_err(|e| MapIoError::Image {
+            path: path.to_path_buf(),
+            message: e.to_string(),
+        })?;
+    let rgb = img.to_rgb8();
+    let pixels = rgb
+        .pixels()
+        .map(|p| ((p[0] as u16 + p[1] as u16 + p[2] as u16) / 3) as u8)
+        .collect();
+    Ok(GreyImage {
+        width: w,
+        height: h,
+        pixels,
+    })
+}
+
+/// Parses a PGM file's bytes.
+pub fn parse_pgm(bytes: &[u8], path: &Path) -> Result<GreyImage, MapIoError> {
+    let err = |message: String| MapIoError::Pgm {
+        path: path.to_path_buf(),
+        message,
+    };
+    let magic = bytes
+        .get(..2)
+        .ok_or_else(|| err("file too short for a header".into()))?;
+    let binary = match magic {
+        b"P5" => true,
+        b"P2" => false,
+        _ => {
+            return Err(err(format!(
+                "magic number `{}` is not P5 (binary) or P2 (ASCII grey)",
+                String::from_utf8_lossy(magic)
+            )));
+        }
+    };
+    let mut pos = 2;
+    let mut header = [0usize; 3];
+    for (k, name) in ["width", "height", "maxval"].iter().enumerate() {
+        header[k] = next_number(bytes, &mut pos)
+            .ok_or_else(|| err(format!("missing or bad {name} in header")))?;
+    }
+    let [w, h, maxval] = header;
+    if w == 0 || h == 0 {
+        return Err(err(format!("empty image ({w}x{h})")));
+    }
+    if !(1..=65535).contains(&maxval) {
+        return Err(err(format!("maxval {maxval} outside 1..65535")));
+    }
+    if w.saturating_mul(h) > MAX_CELLS {
+        return Err(MapIoError::TooLarge {
+            path: path.to_path_buf(),
+            width: w,
+            height: h,
+        });
+    }
+    let n = w * h;
+    let scale = |v: usize| -> u8 { ((v.min(maxval) * 255 + maxval / 2) / maxval) as u8 };
+    let mut pixels = Vec::with_capacity(n);
+    if binary {
+        pos += 1; // exactly one whitespace byte after maxval
+        let bpp = if maxval > 255 { 2 } else { 1 };
+        let data = bytes.get(pos..).unwrap_or(&[]);
+        if data.len() < n * bpp {
+            return Err(err(format!(
+                "truncated: {} of {} pixel bytes present",
+                data.len(),
+                n * bpp
+            )));
+        }
+        if bpp == 1 {
+            pixels.extend(data[..n].iter().map(|&v| scale(v as usize)));
+        } else {
+            pixels.extend(
+                data[..2 * n]
+                    .chunks_exact(2)
+                    .map(|c| scale(((c[0] as usize) << 8) | c[1] as usize)),
+            );
+        }
+    } else {
+        for k in 0..n {
+            let v = next_number(bytes, &mut pos).ok_or_else(|| {
+                err(format!(
+                    "truncated: pixel {k} of {n} missing or not a number"
+                ))
+            })?;
+            pixels.push(scale(v));
+        }
+    }
+    Ok(GreyImage {
+        width: w,
+        height: h,
+        pixels,
+    })
+}
+
+/// Reads the next whitespace-separated decimal number, skipping `#` comments.
+fn next_number(bytes: &[u8], pos: &mut usize) -> Option<usize> {
+    loop {
+        match bytes.get(*pos)? {
+            b'#' => {
+                while *bytes.get(*pos)? != b'\n' {
+                    *pos += 1;
+                }
+            }
+            c if c.is_ascii_whitespace() => *pos += 1,
+            _ => break,
+        }
+    }
+    let start = *pos;
+    while bytes.get(*pos).is_some_and(u8::is_ascii_digit) {
+        *pos += 1;
+    }
+    if *pos == start || *pos - start > 12 {
+        return None;
+    }
+    std::str::from_utf8(&bytes[start..*pos]).ok()?.parse().ok()
+}
+
+/// Renders a grid as a trinary grey image, top row first: occupied 0, free 254, unknown 205.
+pub fn grid_to_image(grid: &OccupancyGrid) -> GreyImage {
+    let (w, h) = (grid.width(), grid.height());
+    let mut pixels = vec![PGM_UNKNOWN; w * h];
+    for iy in 0..h {
+        let row = h - 1 - iy;
+        for ix in 0..w {
+            pixels[row * w + ix] = match grid.state(ix, iy) {
+                CellState::Occupied => PGM_OCCUPIED,
+                CellState::Free => PGM_FREE,
+                CellState::Unknown => PGM_UNKNOWN,
+            };
+        }
+    }
+    GreyImage {
+        width: w,
+        height: h,
+        pixels,
+    }
+}
+
+/// Encodes a grey image as binary PGM (P5).
+pub fn encode_pgm(img: &GreyImage) -> Vec<u8> {
+    let mut out = format!(
+        "P5\n# written by mrslam\n{} {}\n255\n",
+        img.width, img.height
+    )
+    .into_bytes();
+    out.extend_from_slice(&img.pixels);
+    out
+}
+
+/// Encodes a grey image as PNG.
+pub fn encode_png(img: &GreyImage, path: &Path) -> Result<Vec<u8>, MapIoError> {
+    let mut out = Vec::new();
+    let buf = image::GrayImage::from_raw(img.width as u32, img.height as u32, img.pixels.clone())
+        .ok_or_else(|| MapIoError::Image {
+        path: path.to_path_buf(),
+        message: "pixel count mismatch".into(),
+    })?;
+    buf.write_to(&mut std::io::Cursor::new(&mut out), image::ImageFormat::Png)
+        .map_err(|e| MapIoError::Image {
+            path: path.to_path_buf(),
+            message: e.to_string(),
+        })?;
+    Ok(out)
+}
+
+/// Writes a grid as map_server files: `yaml_path` and a trinary PGM beside it with the same stem.
+///
+/// Both files are written to temporary names and renamed into place, the YAML last, so a reader never
+/// sees a half-written map.
+pub fn write_ros_map(grid: &OccupancyGrid, yaml_path: &Path) -> Result<(), MapIoError> {
+    let pgm_path = yaml_path.with_extension("pgm");
+    let image_name = pgm_path
+        .file_name()
+        .and_then(|s| s.to_str())
+        .unwrap_or("map.pgm")
+        .to_string();
+    write_file_atomic(&pgm_path, &encode_pgm(&grid_to_image(grid)))?;
+    write_file_atomic(yaml_path, map_yaml_text(grid, &image_name).as_bytes())
+}
+
+/// The YAML text map_server reads for `grid` stored in `image_name`.
+pub fn map_yaml_text(grid: &OccupancyGrid, image_name: &str) -> String {
+    let o: &Pose2 = grid.origin();
+    let mut s = String::new();
+    let _ = writeln!(s, "image: {image_name}");
+    let _ = writeln!(s, "mode: trinary");
+    let _ = writeln!(s, "resolution: {}", grid.resolution());
+    let _ = writeln!(
+        s,
+        "origin: [{}, {}, {}]",
+        o.translation.x,
+        o.translation.y,
+        o.rotation.angle()
+    );
+    let _ = writeln!(s, "negate: 0");
+    let _ = writeln!(s, "occupied_thresh: 0.65");
+    let _ = writeln!(s, "free_thresh: 0.196");
+    s
+}
+
+/// Writes `bytes` to `path` through a temporary file in the same folder and a rename.
+pub fn write_file_atomic(path: &Path, bytes: &[u8]) -> Result<(), MapIoError> {
+    let dir = path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    let name = path
+        .file_name()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let tmp = dir.join(format!(".{name}.tmp{}", std::process::id()));
+    let result = (|| {
+        let mut f = std::fs::File::create(&tmp)?;
+        f.write_all(bytes)?;
+        f.sync_all()?;
+        std::fs::rename(&tmp, path)
+    })();
+    if let Err(source) = result {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(MapIoError::Io {
+            path: path.to_path_buf(),
+            source,
+        });
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::grid::LogOddsParams;
+
+    fn yaml(text: &str) -> Result<MapYaml, MapIoError> {
+        parse_map_yaml(text, Path::new("m.yaml"))
+    }
+
+    fn write(dir: &Path, name: &str, bytes: &[u8]) -> PathBuf {
+        let p = dir.join(name);
+        std::fs::write(&p, bytes).unwrap();
+        p
+    }
+
+    fn sample_grid() -> OccupancyGrid {
+        let mut g = OccupancyGrid::new(7, 5, 0.05, pose(-1.0, 2.5, 0.25)).unwrap();
+        for iy in 0..5 {
+            for ix in 0..7 {
+                let l = match (ix + 2 * iy) % 3 {
+                    0 => ROS_LOGODDS_LIMIT,
+                    1 => -ROS_LOGODDS_LIMIT,
+                    _ => 0.0,
+                };
+                g.set(ix, iy, l);
+            }
+        }
+        g
+    }
+
+    #[test]
+    fn write_then_read_gives_same_cells() {
+        let dir = tempfile::tempdir().unwrap();
+        let g = sample_grid();
+        let p = dir.path().join("map.yaml");
+        write_ros_map(&g, &p).unwrap();
+        let back = read_ros_map(&p).unwrap();
+        assert_eq!(back.cells(), g.cells());
+        assert_eq!((back.width(), back.height()), (7, 5));
+        let (x, y, t) = crate::pose::pose_xyt(back.origin());
+        assert!((x + 1.0).abs() < 1e-12 && (y - 2.5).abs() < 1e-12 && (t - 0.25).abs() < 1e-12);
+        assert!(dir.path().join("map.pgm").exists());
+        // no temporary files left behind
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 2);
+    }
+
+    #[test]
+    fn scan_built_grid_survives_round_trip_by_state() {
+        let mut g = OccupancyGrid::new(10, 10, 0.1, pose(0.0, 0.0, 0.0)).unwrap();
+        let scan = crate::scan::LaserScan {
+            stamp: 0.0,
+            angle_min: -1.0,
+            angle_increment: 0.05,
+            range_min: 0.05,
+            range_max: 3.0,
+            ranges: vec![0.8; 40],
+        };
+        for _ in 0..3 {
+            g.integrate_scan(&scan, &pose(0.5, 0.5, 0.3), &LogOddsParams::default())
+                .unwrap();
+        }
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("m.yaml");
+        write_ros_map(&g, &p).unwrap();
+        let back = read_ros_map(&p).unwrap();
+        for iy in 0..g.height() {
+            for ix in 0..g.width() {
+                assert_eq!(back.state(ix, iy), g.state(ix, iy));
+            }
+        }
+    }
+
+    #[test]
+    fn reads_both_pgm_kinds_with_negate_and_thresholds() {
+        let dir = tempfile::tempdir().unwrap();
+        // 4x1 pixels: black, dark grey 100, light grey 205, white. p = (255 - v)/255 = 1, .61, .196, 0
+        let p5 = [b"P5\n4 1\n255\n".as_slice(), &[0u8, 100, 205, 255]].concat();
+        write(dir.path(), "b.pgm", &p5);
+        write(dir.path(), "a.pgm", b"P2\n# ascii\n4 1\n15\n0 6 12 15\n");
+        let meta =
+            "resolution: 0.1\norigin: [0, 0, 0]\noccupied_thresh: 0.65\nfree_thresh: 0.196\n";
+        for (img, negate, expect) in [
+            ("b.pgm", 0, [100, -1, -1, 0]),
+            ("b.pgm", 1, [0, -1, 100, 100]),
+            // maxval 15: 0 6 12 15 scale to 0 102 204 255, p = 1, .6, .2, 0
+            ("a.pgm", 0, [100, -1, -1, 0]),
+        ] {
+            let y = write(
+                dir.path(),
+                "m.yaml",
+                format!("image: {img}\nnegate: {negate}\n{meta}").as_bytes(),
+            );
+            let g = read_ros_map(&y).unwrap();
+            let got: Vec<i8> = g
+                .to_ros_int8()
+                .iter()
+                .map(|&v| {
+                    if v == -1 {
+                        -1
+                    } else if v > 50 {
+                        100
+                    } else {
+                        0
+                    }
+                })
+                .collect();
+            let expect: Vec<i8> = expect.iter().map(|&v| v as i8).collect();
+            assert_eq!(got, expect, "{img} negate {negate}");
+        }
+    }
+
+    #[test]
+    fn scale_and_raw_modes() {
+        let dir = tempfile::tempdir().unwrap();
+        write(
+            dir.path(),
+            "r.pgm",
+            &[b"P5 3 1 255\n".as_slice(), &[0u8, 100, 255]].concat(),
+        );
+        let y = write(
+            dir.path(),
+            "r.yaml",
+            b"image: r.pgm\nresolution: 1\norigin: [0,0,0]\nmode: raw\n",
+        );
+        let g = read_ros_map(&y).unwrap();
+        assert_eq!(g.to_ros_int8(), vec![0, 100, -1]);
+        write(
+            dir.path(),
+            "s.pgm",
+            &[b"P5 3 1 255\n".as_slice(), &[0u8, 110, 255]].concat(),
+        );
+        let y = write(
+            dir.path(),
+            "s.yaml",
+            b"image: s.pgm\nresolution: 1\norigin: [0,0,0]\nmode: scale\n",
+        );
+        let g = read_ros_map(&y).unwrap();
+        let v = g.to_ros_int8();
+        assert_eq!((v[0], v[2]), (100, 0));
+        assert!(v[1] > 0 && v[1] < 100, "graded value kept: {}", v[1]);
+    }
+
+    #[test]
+    fn yaml_errors_name_line_and_field() {
+        let e = yaml("image: m.pgm\norigin: [0, 0, 0]\n")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("m.yaml") && e.contains("missing required field `resolution`"),
+            "{e}"
+        );
+        let e = yaml("image: m.pgm\nresolution: -0.05\norigin: [0, 0, 0]\n")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("m.yaml:2") && e.contains("`resolution`") && e.contains("positive"),
+            "{e}"
+        );
+        let e = yaml("image: m.pgm\nresolution: 0\norigin: [0, 0, 0]\n")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("m.yaml:2"), "{e}");
+        let e = yaml("image: m.pgm\nresolution: 0.05\norigin: [0, 0]\n")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("m.yaml:3") && e.contains("`origin`"), "{e}");
+        let e = yaml("image: m.pgm\nresolution: abc\n")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("m.yaml:2") && e.contains("finite number"), "{e}");
+        let e = yaml("# c\nimage m.pgm\n").unwrap_err().to_string();
+        assert!(e.contains("m.yaml:2") && e.contains("key: value"), "{e}");
+        let ok = yaml("image: 'my map.pgm'  # the map\nresolution: 0.05\norigin: [1, 2, 0.5]\nmode: trinary\n").unwrap();
+        assert_eq!(ok.image, "my map.pgm");
+        assert_eq!(ok.origin, [1.0, 2.0, 0.5]);
+    }
+
+    #[test]
+    fn image_errors_name_the_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let y = write(
+            dir.path(),
+            "m.yaml",
+            b"image: gone.pgm\nresolution: 0.05\norigin: [0, 0, 0]\n",
+        );
+        let e = read_ros_map(&y).unwrap_err().to_string();
+        assert!(e.contains("gone.pgm"), "{e}");
+        write(dir.path(), "bad.pgm", b"P6\n1 1\n255\n\0\0\0");
+        let e = read_grey_image(&dir.path().join("bad.pgm"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("bad.pgm") && e.contains("P6"), "{e}");
+        write(dir.path(), "short.pgm", b"P5\n10 10\n255\n\0\0\0");
+        let e = read_grey_image(&dir.path().join("short.pgm"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("truncated: 3 of 100"), "{e}");
+        write(dir.path(), "short2.pgm", b"P2\n2 2\n255\n1 2 3");
+        let e = read_grey_image(&dir.path().join("short2.pgm"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("truncated"), "{e}");
+        // A header claiming 1e6 x 1e6 pixels is refused before any allocation.
+        write(dir.path(), "huge.pgm", b"P5\n1000000 1000000\n255\n\0");
+        let e = read_grey_image(&dir.path().join("huge.pgm")).unwrap_err();
+        assert!(
+            matches!(
+                e,
+                MapIoError::TooLarge {
+                    width: 1_000_000,
+                    ..
+                }
+            ),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn reads_png_maps() {
+        let dir = tempfile::tempdir().unwrap();
+        let img = GreyImage {
+            width: 2,
+            height: 2,
+            pixels: vec![0, 254, 205, 254],
+        };
+        let p = dir.path().join("m.png");
+        std::fs::write(&p, encode_png(&img, &p).unwrap()).unwrap();
+        assert_eq!(read_grey_image(&p).unwrap(), img);
+    }
+}
