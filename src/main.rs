@@ -1,1 +1,38 @@
-fn main() {}
+//! `mrslam`: the command-line front end of the multi-robot SLAM and map-merging testbed.
+//!
+//! A thin layer: argument parsing, progress, summaries and exit codes. The algorithms live in the
+//! library crates under `crates/`.
+
+mod cmd;
+
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
+
+/// Multi-robot SLAM and map merging testbed: simulate, map, merge, evaluate.
+#[derive(Parser)]
+#[command(name = "mrslam", version, about, long_about = None, propagate_version = true)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Inspect and convert ROS map_server maps.
+    #[command(subcommand)]
+    Map(cmd::map::MapCommand),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Map(c) => cmd::map::run(c),
+    };
+    match result {
+        Ok(code) => code,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::from(1)
+        }
+    }
+}

@@ -65,12 +65,12 @@ pub struct CarmenLog {
 #[derive(Debug, thiserror::Error)]
 pub enum CarmenError {
     /// The file could not be read.
-    #[error("{path}: {source}")]
+    #[error("{path}: {cause}")]
     Io {
         /// File at fault.
         path: PathBuf,
         /// Underlying error.
-        source: std::io::Error,
+        cause: std::io::Error,
     },
     /// A line of a known kind is malformed.
     #[error("{path}:{line}: {kind}: {message}")]
@@ -97,9 +97,9 @@ struct OldLaser {
 impl CarmenLog {
     /// Reads a log file, gunzipping it when it starts with the gzip magic bytes.
     pub fn read(path: &Path) -> Result<CarmenLog, CarmenError> {
-        let io = |source| CarmenError::Io {
+        let io = |cause| CarmenError::Io {
             path: path.to_path_buf(),
-            source,
+            cause,
         };
         let mut file = std::fs::File::open(path).map_err(io)?;
         let mut magic = [0u8; 2];
@@ -130,9 +130,9 @@ impl CarmenLog {
         };
         for (i, line) in reader.lines().enumerate() {
             let line_no = i + 1;
-            let line = line.map_err(|source| CarmenError::Io {
+            let line = line.map_err(|cause| CarmenError::Io {
                 path: path.to_path_buf(),
-                source,
+                cause,
             })?;
             let mut fields = line.split_whitespace();
             let Some(kind) = fields.next() else { continue };

@@ -59,12 +59,12 @@ pub struct MapYaml {
 #[derive(Debug, thiserror::Error)]
 pub enum MapIoError {
     /// The file could not be read or written.
-    #[error("{path}: {source}")]
+    #[error("{path}: {cause}")]
     Io {
         /// File at fault.
         path: PathBuf,
         /// Underlying error.
-        source: std::io::Error,
+        cause: std::io::Error,
     },
     /// A YAML line could not be understood.
     #[error("{path}:{line}: {message}")]
@@ -123,19 +123,19 @@ pub enum MapIoError {
         height: usize,
     },
     /// The grid could not be built.
-    #[error("{path}: {source}")]
+    #[error("{path}: {cause}")]
     Grid {
         /// File at fault.
         path: PathBuf,
         /// Underlying error.
-        source: GridError,
+        cause: GridError,
     },
 }
 
 fn io_err(path: &Path) -> impl FnOnce(std::io::Error) -> MapIoError + '_ {
-    move |source| MapIoError::Io {
+    move |cause| MapIoError::Io {
         path: path.to_path_buf(),
-        source,
+        cause,
     }
 }
 
@@ -156,9 +156,9 @@ pub fn read_ros_map(yaml_path: &Path) -> Result<OccupancyGrid, MapIoError> {
     let meta = parse_map_yaml(&text, yaml_path)?;
     let image_path = resolve_image_path(yaml_path, &meta.image);
     let img = read_grey_image(&image_path)?;
-    grid_from_image(&img, &meta).map_err(|source| MapIoError::Grid {
+    grid_from_image(&img, &meta).map_err(|cause| MapIoError::Grid {
         path: yaml_path.to_path_buf(),
-        source,
+        cause,
     })
 }
 
@@ -667,11 +667,11 @@ pub fn write_file_atomic(path: &Path, bytes: &[u8]) -> Result<(), MapIoError> {
         f.sync_all()?;
         std::fs::rename(&tmp, path)
     })();
-    if let Err(source) = result {
+    if let Err(cause) = result {
         let _ = std::fs::remove_file(&tmp);
         return Err(MapIoError::Io {
             path: path.to_path_buf(),
-            source,
+            cause,
         });
     }
     Ok(())

@@ -1,0 +1,126 @@
+//! `mrslam map info|convert`: look at and convert ROS map_server maps.
+
+use anyhow::{Context, Result, bail};
+use clap::Subcommand;
+use mrslam_core::map_io::{self, GreyImage, MapMode, MapYaml};
+use mrslam_core::pose::pose_xyt;
+use mrslam_core::{OccupancyGrid, map_io::grid_from_image};
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+/// Map subcommands.
+#[derive(Subcommand)]
+pub enum MapCommand {
+    /// Print a map's size, resolution, origin, cell counts and the bounding box of its known cells.
+    Info {
+        /// Map YAML (map_server format), or a PGM/PNG image (read at --resolution).
+        map: PathBuf,
+        /// Metres per pixel when MAP is a bare image.
+        #[arg(long, default_value_t = 0.05)]
+        resolution: f64,
+    },
+    /// Convert a map between forms: YAML+PGM, bare PGM or PNG, chosen by OUT's extension.
+    Convert {
+        /// Input: map YAML, or a PGM/PNG image (read at --resolution, origin 0).
+        input: PathBuf,
+        /// Output: .yaml (writes a trinary PGM beside it), .pgm or .png (trinary image only).
+        output: PathBuf,
+        /// Metres per pixel when INPUT is a bare image.
+        #[arg(long, default_value_t = 0.05)]
+        resolution: f64,
+    },
+}
+
+/// Runs a map subcommand.
+pub fn run(cmd: MapCommand) -> Result<ExitCode> {
+    match cmd {
+        MapCommand::Info { map, resolution } => {
+            let grid = load_map(&map, resolution)?;
+            print!("{}", info_text(&map, &grid));
+        }
+        MapCommand::Convert { input, output, resolution } => {
+            let grid = load_map(&input, resolution)?;
+            save_map(&grid, &output)?;
+            println!("wrote {} ({}x{} cells at {} m)", output.display(), grid.width(), grid.height(), grid.resolution());
+        }
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Loads a map from a YAML file, or from a bare image at the given resolution.
+pub fn load_map(path: &Path, resolution: f64) -> Result<OccupancyGrid> {
+    match extension(path).as_str() {
+        "yaml" | "yml" => Ok(map_io::read_ros_map(path)?),
+        "pgm" | "png" => {
+            let img = map_io::read_grey_image(path)?;
+            let meta = MapYaml {
+                image: path.display().to_string(),
+                resolution,
+                origin: [0.0; 3],
+                negate: false,
+                occupied_thresh: 0.65,
+                free_thresh: 0.196,
+                mode: MapMode::Trinary,
+            };
+            grid_from_image(&img, &meta).with_context(|| format!("{}", path.display()))
+        }
+        other => bail!("{}: unknown map format `.{other}` (expected .yaml, .pgm or .png)", path.display()),
+    }
+}
+
+/// Saves a map as YAML+PGM, or as a bare trinary PGM or PNG, by the path's extension.
+pub fn save_map(grid: &OccupancyGrid, path: &Path) -> Result<()> {
+    match extension(path).as_str() {
+        "yaml" | "yml" => map_io::write_ros_map(grid, path)?,
+        "pgm" => map_io::write_file_atomic(path, &map_io::encode_pgm(&map_io::grid_to_image(grid)))?,
+        "png" => {
+            let img: GreyImage = map_io::grid_to_image(grid);
+            map_io::write_file_atomic(path, &map_io::encode_png(&img, path)?)?
+        }
+        other => bail!("{}: unknown output format `.{other}` (expected .yaml, .pgm or .png)", path.display()),
+    }
+    Ok(())
+}
+
+fn extension(path: &Path) -> String {
+    path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase()
+}
+
+/// The human summary `map info` prints.
+pub fn info_text(path: &Path, grid: &OccupancyGrid) -> String {
+    let (free, occ, unknown) = grid.state_counts();
+    let (x, y, yaw) = pose_xyt(grid.origin());
+    let res = grid.resolution();
+    let mut s = format!(
+        "map:        {}\nsize:       {} x {} cells ({:.2} x {:.2} m)\nresolution: {} m/cell\norigin:     x {:.3} m, y {:.3} m, yaw {:.4} rad\ncells:      {} free, {} occupied, {} unknown\n",
+        path.display(),
+        grid.width(),
+        grid.height(),
+        grid.width() as f64 * res,
+        grid.height() as f64 * res,
+        res,
+        x,
+        y,
+        yaw,
+        free,
+        occ,
+        unknown
+    );
+    match grid.known_bounds() {
+        Some((x0, y0, x1, y1)) => {
+            let lo = grid.cell_f_to_world(x0 as f64, y0 as f64);
+            let hi = grid.cell_f_to_world(x1 as f64 + 1.0, y1 as f64 + 1.0);
+            s += &format!(
+                "known bbox: cells x {x0}..={x1}, y {y0}..={y1} ({} x {} cells); map frame ({:.3}, {:.3}) to ({:.3}, {:.3}) m\n",
+                x1 - x0 + 1,
+                y1 - y0 + 1,
+                lo.x,
+                lo.y,
+                hi.x,
+                hi.y
+            );
+        }
+        None => s += "known bbox: none (no known cells)\n",
+    }
+    s
+}
