@@ -21,12 +21,16 @@ enum Command {
     /// Inspect and convert ROS map_server maps.
     #[command(subcommand)]
     Map(cmd::map::MapCommand),
+    /// Inspect CARMEN laser logs.
+    #[command(subcommand)]
+    Log(cmd::log::LogCommand),
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Map(c) => cmd::map::run(c),
+        Command::Log(c) => cmd::log::run(c),
     };
     match result {
         Ok(code) => code,

@@ -38,10 +38,20 @@ pub fn run(cmd: MapCommand) -> Result<ExitCode> {
             let grid = load_map(&map, resolution)?;
             print!("{}", info_text(&map, &grid));
         }
-        MapCommand::Convert { input, output, resolution } => {
+        MapCommand::Convert {
+            input,
+            output,
+            resolution,
+        } => {
             let grid = load_map(&input, resolution)?;
             save_map(&grid, &output)?;
-            println!("wrote {} ({}x{} cells at {} m)", output.display(), grid.width(), grid.height(), grid.resolution());
+            println!(
+                "wrote {} ({}x{} cells at {} m)",
+                output.display(),
+                grid.width(),
+                grid.height(),
+                grid.resolution()
+            );
         }
     }
     Ok(ExitCode::SUCCESS)
@@ -64,7 +74,10 @@ pub fn load_map(path: &Path, resolution: f64) -> Result<OccupancyGrid> {
             };
             grid_from_image(&img, &meta).with_context(|| format!("{}", path.display()))
         }
-        other => bail!("{}: unknown map format `.{other}` (expected .yaml, .pgm or .png)", path.display()),
+        other => bail!(
+            "{}: unknown map format `.{other}` (expected .yaml, .pgm or .png)",
+            path.display()
+        ),
     }
 }
 
@@ -72,18 +85,26 @@ pub fn load_map(path: &Path, resolution: f64) -> Result<OccupancyGrid> {
 pub fn save_map(grid: &OccupancyGrid, path: &Path) -> Result<()> {
     match extension(path).as_str() {
         "yaml" | "yml" => map_io::write_ros_map(grid, path)?,
-        "pgm" => map_io::write_file_atomic(path, &map_io::encode_pgm(&map_io::grid_to_image(grid)))?,
+        "pgm" => {
+            map_io::write_file_atomic(path, &map_io::encode_pgm(&map_io::grid_to_image(grid)))?
+        }
         "png" => {
             let img: GreyImage = map_io::grid_to_image(grid);
             map_io::write_file_atomic(path, &map_io::encode_png(&img, path)?)?
         }
-        other => bail!("{}: unknown output format `.{other}` (expected .yaml, .pgm or .png)", path.display()),
+        other => bail!(
+            "{}: unknown output format `.{other}` (expected .yaml, .pgm or .png)",
+            path.display()
+        ),
     }
     Ok(())
 }
 
 fn extension(path: &Path) -> String {
-    path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase()
+    path.extension()
+        .and_then(|e| e.to_str())
+        .unwrap_or("")
+        .to_ascii_lowercase()
 }
 
 /// The human summary `map info` prints.
