@@ -21,6 +21,8 @@ enum Command {
     /// Inspect and convert ROS map_server maps.
     #[command(subcommand)]
     Map(cmd::map::MapCommand),
+    /// Merge two maps of unknown relative pose (exit 2 when no reliable transform is found).
+    Merge(cmd::merge::MergeArgs),
     /// Inspect CARMEN laser logs.
     #[command(subcommand)]
     Log(cmd::log::LogCommand),
@@ -31,6 +33,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Map(c) => cmd::map::run(c),
         Command::Log(c) => cmd::log::run(c),
+        Command::Merge(a) => cmd::merge::run(a),
     };
     match result {
         Ok(code) => code,

@@ -4,10 +4,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 fn mrslam(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_mrslam"))
-        .args(args)
-        .output()
-        .expect("mrslam runs")
+    Command::new(env!("CARGO_BIN_EXE_mrslam")).args(args).output().expect("mrslam runs")
 }
 
 fn stderr(o: &Output) -> String {
@@ -33,22 +30,13 @@ fn small_map(dir: &Path) -> PathBuf {
         0, 254, 254, 254, 254, 254,
         0, 0,   0,   0,   0,   0,
     ];
-    write(
-        dir,
-        "small.pgm",
-        &[b"P5\n6 4\n255\n".as_slice(), &px].concat(),
-    );
+    write(dir, "small.pgm", &[b"P5\n6 4\n255\n".as_slice(), &px].concat());
     write(dir, "small.yaml", b"image: small.pgm\nresolution: 0.1\norigin: [-1.0, 2.0, 0.0]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n")
 }
 
 fn assert_fails_with(args: &[&str], needles: &[&str]) {
     let o = mrslam(args);
-    assert_eq!(
-        o.status.code(),
-        Some(1),
-        "exit code for {args:?}; stderr: {}",
-        stderr(&o)
-    );
+    assert_eq!(o.status.code(), Some(1), "exit code for {args:?}; stderr: {}", stderr(&o));
     let e = stderr(&o);
     assert!(!e.contains("panicked"), "{e}");
     for n in needles {
@@ -75,22 +63,10 @@ fn map_convert_round_trips_through_png_and_yaml() {
     let dir = tempfile::tempdir().unwrap();
     let map = small_map(dir.path());
     let png = dir.path().join("out.png");
-    let o = mrslam(&[
-        "map",
-        "convert",
-        map.to_str().unwrap(),
-        png.to_str().unwrap(),
-    ]);
+    let o = mrslam(&["map", "convert", map.to_str().unwrap(), png.to_str().unwrap()]);
     assert!(o.status.success(), "{}", stderr(&o));
     let yaml = dir.path().join("again.yaml");
-    let o = mrslam(&[
-        "map",
-        "convert",
-        png.to_str().unwrap(),
-        yaml.to_str().unwrap(),
-        "--resolution",
-        "0.1",
-    ]);
+    let o = mrslam(&["map", "convert", png.to_str().unwrap(), yaml.to_str().unwrap(), "--resolution", "0.1"]);
     assert!(o.status.success(), "{}", stderr(&o));
     let a = mrslam_core::map_io::read_ros_map(&map).unwrap();
     let b = mrslam_core::map_io::read_ros_map(&yaml).unwrap();
@@ -103,84 +79,33 @@ fn bad_maps_exit_1_naming_file_and_problem() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let meta = "resolution: 0.05\norigin: [0, 0, 0]\n";
-    let missing = write(
-        d,
-        "missing.yaml",
-        format!("image: nowhere.pgm\n{meta}").as_bytes(),
-    );
-    assert_fails_with(
-        &["map", "info", missing.to_str().unwrap()],
-        &["nowhere.pgm", "No such file"],
-    );
+    let missing = write(d, "missing.yaml", format!("image: nowhere.pgm\n{meta}").as_bytes());
+    assert_fails_with(&["map", "info", missing.to_str().unwrap()], &["nowhere.pgm", "No such file"]);
 
     write(d, "magic.pgm", b"P6\n2 2\n255\n............");
-    let magic = write(
-        d,
-        "magic.yaml",
-        format!("image: magic.pgm\n{meta}").as_bytes(),
-    );
-    assert_fails_with(
-        &["map", "info", magic.to_str().unwrap()],
-        &["magic.pgm", "magic number `P6`"],
-    );
+    let magic = write(d, "magic.yaml", format!("image: magic.pgm\n{meta}").as_bytes());
+    assert_fails_with(&["map", "info", magic.to_str().unwrap()], &["magic.pgm", "magic number `P6`"]);
 
     write(d, "trunc.pgm", b"P5\n20 20\n255\n\x00\x01");
-    let trunc = write(
-        d,
-        "trunc.yaml",
-        format!("image: trunc.pgm\n{meta}").as_bytes(),
-    );
-    assert_fails_with(
-        &["map", "info", trunc.to_str().unwrap()],
-        &["trunc.pgm", "truncated"],
-    );
+    let trunc = write(d, "trunc.yaml", format!("image: trunc.pgm\n{meta}").as_bytes());
+    assert_fails_with(&["map", "info", trunc.to_str().unwrap()], &["trunc.pgm", "truncated"]);
 
     write(d, "ok.pgm", b"P5\n1 1\n255\n\x00");
     let nores = write(d, "nores.yaml", b"image: ok.pgm\norigin: [0, 0, 0]\n");
-    assert_fails_with(
-        &["map", "info", nores.to_str().unwrap()],
-        &["nores.yaml", "resolution"],
-    );
+    assert_fails_with(&["map", "info", nores.to_str().unwrap()], &["nores.yaml", "resolution"]);
 
-    let negres = write(
-        d,
-        "negres.yaml",
-        b"image: ok.pgm\nresolution: -0.05\norigin: [0, 0, 0]\n",
-    );
-    assert_fails_with(
-        &["map", "info", negres.to_str().unwrap()],
-        &["negres.yaml:2", "resolution", "positive"],
-    );
-    let zero = write(
-        d,
-        "zero.yaml",
-        b"image: ok.pgm\nresolution: 0\norigin: [0, 0, 0]\n",
-    );
-    assert_fails_with(
-        &["map", "info", zero.to_str().unwrap()],
-        &["zero.yaml:2", "resolution"],
-    );
+    let negres = write(d, "negres.yaml", b"image: ok.pgm\nresolution: -0.05\norigin: [0, 0, 0]\n");
+    assert_fails_with(&["map", "info", negres.to_str().unwrap()], &["negres.yaml:2", "resolution", "positive"]);
+    let zero = write(d, "zero.yaml", b"image: ok.pgm\nresolution: 0\norigin: [0, 0, 0]\n");
+    assert_fails_with(&["map", "info", zero.to_str().unwrap()], &["zero.yaml:2", "resolution"]);
 
     write(d, "huge.pgm", b"P5\n300000 300000\n255\n\x00");
-    let huge = write(
-        d,
-        "huge.yaml",
-        format!("image: huge.pgm\n{meta}").as_bytes(),
-    );
-    assert_fails_with(
-        &["map", "info", huge.to_str().unwrap()],
-        &["huge.pgm", "exceeds the limit"],
-    );
+    let huge = write(d, "huge.yaml", format!("image: huge.pgm\n{meta}").as_bytes());
+    assert_fails_with(&["map", "info", huge.to_str().unwrap()], &["huge.pgm", "exceeds the limit"]);
 
-    assert_fails_with(
-        &["map", "info", d.join("absent.yaml").to_str().unwrap()],
-        &["absent.yaml"],
-    );
+    assert_fails_with(&["map", "info", d.join("absent.yaml").to_str().unwrap()], &["absent.yaml"]);
     let txt = write(d, "map.txt", b"hello");
-    assert_fails_with(
-        &["map", "info", txt.to_str().unwrap()],
-        &["map.txt", "unknown map format"],
-    );
+    assert_fails_with(&["map", "info", txt.to_str().unwrap()], &["map.txt", "unknown map format"]);
 }
 
 #[test]
@@ -188,15 +113,7 @@ fn convert_to_unwritable_place_fails_and_leaves_nothing() {
     let dir = tempfile::tempdir().unwrap();
     let map = small_map(dir.path());
     let out = dir.path().join("no/such/dir/out.yaml");
-    assert_fails_with(
-        &[
-            "map",
-            "convert",
-            map.to_str().unwrap(),
-            out.to_str().unwrap(),
-        ],
-        &["out.pgm"],
-    );
+    assert_fails_with(&["map", "convert", map.to_str().unwrap(), out.to_str().unwrap()], &["out.pgm"]);
     assert!(!out.exists());
 }
 
@@ -211,18 +128,8 @@ fn log_info_counts_and_bad_line_names_its_number() {
     let o = mrslam(&["log", "info", good.to_str().unwrap()]);
     assert!(o.status.success(), "{}", stderr(&o));
     let out = stdout(&o);
-    assert!(
-        out.contains("scans:     1") && out.contains("1 NEFF") && out.contains("3 beams"),
-        "{out}"
-    );
+    assert!(out.contains("scans:     1") && out.contains("1 NEFF") && out.contains("3 beams"), "{out}");
 
-    let bad = write(
-        dir.path(),
-        "bad.clf",
-        b"ODOM 0 0 0 0 0 0 1.0 h 1.0\nFLASER 3 1 2 3 0 0\n",
-    );
-    assert_fails_with(
-        &["log", "info", bad.to_str().unwrap()],
-        &["bad.clf:2", "FLASER", "expected at least"],
-    );
+    let bad = write(dir.path(), "bad.clf", b"ODOM 0 0 0 0 0 0 1.0 h 1.0\nFLASER 3 1 2 3 0 0\n");
+    assert_fails_with(&["log", "info", bad.to_str().unwrap()], &["bad.clf:2", "FLASER", "expected at least"]);
 }

@@ -42,19 +42,8 @@ pub fn run(cmd: LogCommand) -> Result<ExitCode> {
             }
             println!("odometry:  {} ODOM lines", parsed.odometry.len());
             println!("params:    {}", parsed.params.len());
-            let skipped: Vec<String> = parsed
-                .skipped
-                .iter()
-                .map(|(k, n)| format!("{n} {k}"))
-                .collect();
-            println!(
-                "skipped:   {}",
-                if skipped.is_empty() {
-                    "none".to_string()
-                } else {
-                    skipped.join(", ")
-                }
-            );
+            let skipped: Vec<String> = parsed.skipped.iter().map(|(k, n)| format!("{n} {k}")).collect();
+            println!("skipped:   {}", if skipped.is_empty() { "none".to_string() } else { skipped.join(", ") });
         }
     }
     Ok(ExitCode::SUCCESS)

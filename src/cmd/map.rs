@@ -5,6 +5,7 @@ use clap::Subcommand;
 use mrslam_core::map_io::{self, GreyImage, MapMode, MapYaml};
 use mrslam_core::pose::pose_xyt;
 use mrslam_core::{OccupancyGrid, map_io::grid_from_image};
+use mrslam_merge::pairs::{PairSpec, cut_pair};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -29,6 +30,24 @@ pub enum MapCommand {
         #[arg(long, default_value_t = 0.05)]
         resolution: f64,
     },
+    /// Cut a map into two overlapping halves and move the second at random: a merge test pair with its truth.
+    Cut {
+        /// Map YAML to cut.
+        map: PathBuf,
+        /// First half (stays in the map's frame).
+        a: PathBuf,
+        /// Second half (rotated and shifted; the true transform is printed).
+        b: PathBuf,
+        /// Jaccard overlap of the halves' known cells; negative leaves a gap of that fraction.
+        #[arg(long, default_value_t = 0.3, allow_negative_numbers = true)]
+        overlap: f64,
+        /// Largest shift of the second half, metres.
+        #[arg(long, default_value_t = 5.0)]
+        max_shift: f64,
+        /// Seed of the cut direction and the move.
+        #[arg(long, default_value_t = 0)]
+        seed: u64,
+    },
 }
 
 /// Runs a map subcommand.
@@ -38,11 +57,7 @@ pub fn run(cmd: MapCommand) -> Result<ExitCode> {
             let grid = load_map(&map, resolution)?;
             print!("{}", info_text(&map, &grid));
         }
-        MapCommand::Convert {
-            input,
-            output,
-            resolution,
-        } => {
+        MapCommand::Convert { input, output, resolution } => {
             let grid = load_map(&input, resolution)?;
             save_map(&grid, &output)?;
             println!(
@@ -52,6 +67,19 @@ pub fn run(cmd: MapCommand) -> Result<ExitCode> {
                 grid.height(),
                 grid.resolution()
             );
+        }
+        MapCommand::Cut { map, a, b, overlap, max_shift, seed } => {
+            if !(-0.9..0.95).contains(&overlap) {
+                bail!("--overlap {overlap}: must lie in [-0.9, 0.95)");
+            }
+            let grid = load_map(&map, 0.05)?;
+            let spec = PairSpec { overlap, max_shift_m: max_shift, rotate: true };
+            let pair = cut_pair(&grid, &spec, seed);
+            map_io::write_ros_map(&pair.a, &a)?;
+            map_io::write_ros_map(&pair.b, &b)?;
+            let (x, y, th) = pose_xyt(&pair.t_a_b);
+            println!("wrote {} and {} (overlap {:.3})", a.display(), b.display(), pair.overlap);
+            println!("true transform b -> a: x {x:.4} m, y {y:.4} m, theta {th:.5} rad ({:.3} deg)", th.to_degrees());
         }
     }
     Ok(ExitCode::SUCCESS)
@@ -74,10 +102,7 @@ pub fn load_map(path: &Path, resolution: f64) -> Result<OccupancyGrid> {
             };
             grid_from_image(&img, &meta).with_context(|| format!("{}", path.display()))
         }
-        other => bail!(
-            "{}: unknown map format `.{other}` (expected .yaml, .pgm or .png)",
-            path.display()
-        ),
+        other => bail!("{}: unknown map format `.{other}` (expected .yaml, .pgm or .png)", path.display()),
     }
 }
 
@@ -85,26 +110,18 @@ pub fn load_map(path: &Path, resolution: f64) -> Result<OccupancyGrid> {
 pub fn save_map(grid: &OccupancyGrid, path: &Path) -> Result<()> {
     match extension(path).as_str() {
         "yaml" | "yml" => map_io::write_ros_map(grid, path)?,
-        "pgm" => {
-            map_io::write_file_atomic(path, &map_io::encode_pgm(&map_io::grid_to_image(grid)))?
-        }
+        "pgm" => map_io::write_file_atomic(path, &map_io::encode_pgm(&map_io::grid_to_image(grid)))?,
         "png" => {
             let img: GreyImage = map_io::grid_to_image(grid);
             map_io::write_file_atomic(path, &map_io::encode_png(&img, path)?)?
         }
-        other => bail!(
-            "{}: unknown output format `.{other}` (expected .yaml, .pgm or .png)",
-            path.display()
-        ),
+        other => bail!("{}: unknown output format `.{other}` (expected .yaml, .pgm or .png)", path.display()),
     }
     Ok(())
 }
 
 fn extension(path: &Path) -> String {
-    path.extension()
-        .and_then(|e| e.to_str())
-        .unwrap_or("")
-        .to_ascii_lowercase()
+    path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase()
 }
 
 /// The human summary `map info` prints.

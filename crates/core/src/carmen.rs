@@ -97,10 +97,7 @@ struct OldLaser {
 impl CarmenLog {
     /// Reads a log file, gunzipping it when it starts with the gzip magic bytes.
     pub fn read(path: &Path) -> Result<CarmenLog, CarmenError> {
-        let io = |cause| CarmenError::Io {
-            path: path.to_path_buf(),
-            cause,
-        };
+        let io = |cause| CarmenError::Io { path: path.to_path_buf(), cause };
         let mut file = std::fs::File::open(path).map_err(io)?;
         let mut magic = [0u8; 2];
         let n = file.read(&mut magic).map_err(io)?;
@@ -116,24 +113,11 @@ impl CarmenLog {
     /// Parses a log from a reader; `path` only names the source in errors.
     pub fn parse(reader: impl BufRead, path: &Path) -> Result<CarmenLog, CarmenError> {
         let mut log = CarmenLog::default();
-        let mut front = OldLaser {
-            fov_deg: None,
-            resolution_deg: None,
-            max_range: None,
-            offset_x: 0.0,
-        };
-        let mut rear = OldLaser {
-            fov_deg: None,
-            resolution_deg: None,
-            max_range: None,
-            offset_x: 0.0,
-        };
+        let mut front = OldLaser { fov_deg: None, resolution_deg: None, max_range: None, offset_x: 0.0 };
+        let mut rear = OldLaser { fov_deg: None, resolution_deg: None, max_range: None, offset_x: 0.0 };
         for (i, line) in reader.lines().enumerate() {
             let line_no = i + 1;
-            let line = line.map_err(|cause| CarmenError::Io {
-                path: path.to_path_buf(),
-                cause,
-            })?;
+            let line = line.map_err(|cause| CarmenError::Io { path: path.to_path_buf(), cause })?;
             let mut fields = line.split_whitespace();
             let Some(kind) = fields.next() else { continue };
             let rest: Vec<&str> = fields.collect();
@@ -162,31 +146,20 @@ impl CarmenLog {
                     }
                 }
                 "FLASER" | "RLASER" => {
-                    let (laser, source) = if kind == "FLASER" {
-                        (&front, LaserSource::Front)
-                    } else {
-                        (&rear, LaserSource::Rear)
-                    };
-                    log.scans
-                        .push(parse_old_laser(&rest, laser, source, line_no).map_err(err)?);
+                    let (laser, source) =
+                        if kind == "FLASER" { (&front, LaserSource::Front) } else { (&rear, LaserSource::Rear) };
+                    log.scans.push(parse_old_laser(&rest, laser, source, line_no).map_err(err)?);
                 }
-                "ROBOTLASER1" => log
-                    .scans
-                    .push(parse_robot_laser(&rest, line_no).map_err(err)?),
+                "ROBOTLASER1" => log.scans.push(parse_robot_laser(&rest, line_no).map_err(err)?),
                 "ODOM" => {
-                    let v =
-                        numbers(&rest, 7, "x y theta tv rv accel ipc_timestamp").map_err(err)?;
-                    log.odometry.push(Odometry {
-                        stamp: v[6],
-                        pose: pose(v[0], v[1], v[2]),
-                    });
+                    let v = numbers(&rest, 7, "x y theta tv rv accel ipc_timestamp").map_err(err)?;
+                    log.odometry.push(Odometry { stamp: v[6], pose: pose(v[0], v[1], v[2]) });
                 }
                 k if k.starts_with('#') => *log.skipped.entry("comment".into()).or_default() += 1,
                 k => *log.skipped.entry(k.to_string()).or_default() += 1,
             }
         }
-        log.scans
-            .sort_by(|a, b| a.scan.stamp.total_cmp(&b.scan.stamp));
+        log.scans.sort_by(|a, b| a.scan.stamp.total_cmp(&b.scan.stamp));
         log.odometry.sort_by(|a, b| a.stamp.total_cmp(&b.stamp));
         Ok(log)
     }
@@ -200,10 +173,7 @@ impl CarmenLog {
 /// Parses the first `n` fields as finite numbers, naming the expected layout on failure.
 fn numbers(fields: &[&str], n: usize, layout: &str) -> Result<Vec<f64>, String> {
     if fields.len() < n {
-        return Err(format!(
-            "expected at least {n} fields ({layout}), found {}",
-            fields.len()
-        ));
+        return Err(format!("expected at least {n} fields ({layout}), found {}", fields.len()));
     }
     fields[..n]
         .iter()
@@ -219,32 +189,18 @@ fn numbers(fields: &[&str], n: usize, layout: &str) -> Result<Vec<f64>, String> 
 
 fn parse_count(fields: &[&str], at: usize, what: &str) -> Result<usize, String> {
     let f = fields.get(at).ok_or_else(|| format!("missing {what}"))?;
-    let n: usize = f
-        .parse()
-        .map_err(|_| format!("{what} `{f}` is not a count"))?;
+    let n: usize = f.parse().map_err(|_| format!("{what} `{f}` is not a count"))?;
     if n > 100_000 {
         return Err(format!("{what} {n} is implausibly large"));
     }
     Ok(n)
 }
 
-fn parse_old_laser(
-    f: &[&str],
-    laser: &OldLaser,
-    source: LaserSource,
-    line: usize,
-) -> Result<ScanRecord, String> {
+fn parse_old_laser(f: &[&str], laser: &OldLaser, source: LaserSource, line: usize) -> Result<ScanRecord, String> {
     let n = parse_count(f, 0, "beam count")?;
-    let ranges: Vec<f32> = numbers(&f[1..], n, "ranges")?
-        .into_iter()
-        .map(|v| v as f32)
-        .collect();
+    let ranges: Vec<f32> = numbers(&f[1..], n, "ranges")?.into_iter().map(|v| v as f32).collect();
     let tail = &f[1 + n..];
-    let v = numbers(
-        tail,
-        7,
-        "x y theta odom_x odom_y odom_theta ipc_timestamp after the ranges",
-    )?;
+    let v = numbers(tail, 7, "x y theta odom_x odom_y odom_theta ipc_timestamp after the ranges")?;
     // Old CARMEN lasers span 180 degrees unless PARAM says otherwise; an odd beam count includes both ends.
     let fov = laser.fov_deg.unwrap_or(180.0).to_radians();
     let inc = match laser.resolution_deg {
@@ -252,26 +208,12 @@ fn parse_old_laser(
         _ if n > 1 && n % 2 == 1 => fov / (n - 1) as f64,
         _ => fov / n.max(1) as f64,
     };
-    let turn = if source == LaserSource::Rear {
-        std::f64::consts::PI
-    } else {
-        0.0
-    };
+    let turn = if source == LaserSource::Rear { std::f64::consts::PI } else { 0.0 };
     let range_max = laser.max_range.unwrap_or(80.0).max(1e-3);
     let stamp = v[6];
     Ok(ScanRecord {
-        odometry: Odometry {
-            stamp,
-            pose: pose(v[3], v[4], v[5]),
-        },
-        scan: LaserScan {
-            stamp,
-            angle_min: -fov / 2.0,
-            angle_increment: inc,
-            range_min: 0.0,
-            range_max,
-            ranges,
-        },
+        odometry: Odometry { stamp, pose: pose(v[3], v[4], v[5]) },
+        scan: LaserScan { stamp, angle_min: -fov / 2.0, angle_increment: inc, range_min: 0.0, range_max, ranges },
         logged_laser_pose: pose(v[0], v[1], v[2]),
         laser_offset: pose(laser.offset_x, 0.0, turn),
         source,
@@ -282,33 +224,17 @@ fn parse_old_laser(
 fn parse_robot_laser(f: &[&str], line: usize) -> Result<ScanRecord, String> {
     let head = numbers(f, 6, "type start_angle fov resolution max_range accuracy")?;
     let n = parse_count(f, 7, "beam count")?;
-    let ranges: Vec<f32> = numbers(&f[8..], n, "ranges")?
-        .into_iter()
-        .map(|v| v as f32)
-        .collect();
+    let ranges: Vec<f32> = numbers(&f[8..], n, "ranges")?.into_iter().map(|v| v as f32).collect();
     let m = parse_count(f, 8 + n, "remission count")?;
-    let tail = f
-        .get(9 + n + m..)
-        .ok_or("line ends inside the remissions")?;
-    let v = numbers(
-        tail,
-        12,
-        "laser pose, robot pose, tv rv, safety distances, turn axis, ipc_timestamp",
-    )?;
+    let tail = f.get(9 + n + m..).ok_or("line ends inside the remissions")?;
+    let v = numbers(tail, 12, "laser pose, robot pose, tv rv, safety distances, turn axis, ipc_timestamp")?;
     let laser = pose(v[0], v[1], v[2]);
     let robot = pose(v[3], v[4], v[5]);
     let range_max = (head[4] as f32).max(1e-3);
     let stamp = v[11];
     Ok(ScanRecord {
         odometry: Odometry { stamp, pose: robot },
-        scan: LaserScan {
-            stamp,
-            angle_min: head[1],
-            angle_increment: head[3],
-            range_min: 0.0,
-            range_max,
-            ranges,
-        },
+        scan: LaserScan { stamp, angle_min: head[1], angle_increment: head[3], range_min: 0.0, range_max, ranges },
         logged_laser_pose: laser,
         laser_offset: robot.inv_mul(&laser),
         source: LaserSource::Robot,
@@ -334,10 +260,7 @@ ODOM 0.0 0.0 0.0 0.0 0.0 0.0 1.0 host 1.0
 ";
 
     fn assert_close(a: (f64, f64, f64), b: (f64, f64, f64)) {
-        assert!(
-            (a.0 - b.0).abs() < 1e-12 && (a.1 - b.1).abs() < 1e-12 && (a.2 - b.2).abs() < 1e-12,
-            "{a:?} != {b:?}"
-        );
+        assert!((a.0 - b.0).abs() < 1e-12 && (a.1 - b.1).abs() < 1e-12 && (a.2 - b.2).abs() < 1e-12, "{a:?} != {b:?}");
     }
 
     #[test]
@@ -349,24 +272,14 @@ ODOM 0.0 0.0 0.0 0.0 0.0 0.0 1.0 host 1.0
         // time-ordered: ROBOTLASER1 (2.5), FLASER (3.0), RLASER (4.0); ODOM 1.0 before 2.0
         let stamps: Vec<f64> = log.scans.iter().map(|s| s.scan.stamp).collect();
         assert_eq!(stamps, [2.5, 3.0, 4.0]);
-        assert_eq!(
-            log.odometry.iter().map(|o| o.stamp).collect::<Vec<_>>(),
-            [1.0, 2.0]
-        );
+        assert_eq!(log.odometry.iter().map(|o| o.stamp).collect::<Vec<_>>(), [1.0, 2.0]);
         let (x, y, t) = pose_xyt(&log.odometry[1].pose);
         assert!((x - 0.5).abs() < 1e-12 && (y - 0.25).abs() < 1e-12 && (t - 0.1).abs() < 1e-12);
 
         let rl = &log.scans[0];
         assert_eq!(rl.source, LaserSource::Robot);
         assert_eq!(rl.scan.ranges, [4.0, 5.0, 6.0]);
-        assert_eq!(
-            (
-                rl.scan.angle_min,
-                rl.scan.angle_increment,
-                rl.scan.range_max
-            ),
-            (-1.5, 1.5, 20.0)
-        );
+        assert_eq!((rl.scan.angle_min, rl.scan.angle_increment, rl.scan.range_max), (-1.5, 1.5, 20.0));
         assert_close(pose_xyt(&rl.odometry.pose), (2.0, 2.0, 0.5));
         let (ox, oy, _) = pose_xyt(&rl.laser_offset);
         assert!((ox.hypot(oy) - 0.1f64.hypot(0.2)).abs() < 1e-9);
@@ -389,17 +302,11 @@ ODOM 0.0 0.0 0.0 0.0 0.0 0.0 1.0 host 1.0
     #[test]
     fn short_line_names_its_number() {
         let text = "ODOM 0 0 0 0 0 0 1 h 1\nFLASER 3 1.0 2.0\n";
-        let e = CarmenLog::parse(text.as_bytes(), Path::new("bad.clf"))
-            .unwrap_err()
-            .to_string();
+        let e = CarmenLog::parse(text.as_bytes(), Path::new("bad.clf")).unwrap_err().to_string();
         assert!(e.starts_with("bad.clf:2: FLASER:"), "{e}");
-        let e = CarmenLog::parse("ODOM 1 2 x 0 0 0 1 h 1\n".as_bytes(), Path::new("b.clf"))
-            .unwrap_err()
-            .to_string();
+        let e = CarmenLog::parse("ODOM 1 2 x 0 0 0 1 h 1\n".as_bytes(), Path::new("b.clf")).unwrap_err().to_string();
         assert!(e.contains("b.clf:1: ODOM: field 3"), "{e}");
-        let e = CarmenLog::parse("FLASER 99999999 1\n".as_bytes(), Path::new("b.clf"))
-            .unwrap_err()
-            .to_string();
+        let e = CarmenLog::parse("FLASER 99999999 1\n".as_bytes(), Path::new("b.clf")).unwrap_err().to_string();
         assert!(e.contains("implausibly large"), "{e}");
     }
 
@@ -408,16 +315,11 @@ ODOM 0.0 0.0 0.0 0.0 0.0 0.0 1.0 host 1.0
         use std::io::Write;
         let dir = tempfile::tempdir().unwrap();
         let p = dir.path().join("log.gz");
-        let mut enc = flate2::write::GzEncoder::new(
-            std::fs::File::create(&p).unwrap(),
-            flate2::Compression::fast(),
-        );
+        let mut enc = flate2::write::GzEncoder::new(std::fs::File::create(&p).unwrap(), flate2::Compression::fast());
         enc.write_all(LOG.as_bytes()).unwrap();
         enc.finish().unwrap();
         assert_eq!(CarmenLog::read(&p).unwrap().scans.len(), 3);
-        let e = CarmenLog::read(&dir.path().join("missing.log"))
-            .unwrap_err()
-            .to_string();
+        let e = CarmenLog::read(&dir.path().join("missing.log")).unwrap_err().to_string();
         assert!(e.contains("missing.log"), "{e}");
     }
 }

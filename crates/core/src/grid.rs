@@ -112,20 +112,9 @@ const GROWTH_MARGIN: i64 = 64;
 
 impl OccupancyGrid {
     /// An all-unknown grid of `width × height` cells.
-    pub fn new(
-        width: usize,
-        height: usize,
-        resolution: f64,
-        origin: Pose2,
-    ) -> Result<Self, GridError> {
+    pub fn new(width: usize, height: usize, resolution: f64, origin: Pose2) -> Result<Self, GridError> {
         check_size(width, height, resolution)?;
-        Ok(OccupancyGrid {
-            resolution,
-            origin,
-            width,
-            height,
-            cells: vec![0.0; width * height],
-        })
+        Ok(OccupancyGrid { resolution, origin, width, height, cells: vec![0.0; width * height] })
     }
 
     /// A grid over the given log-odds cells (row-major, row 0 at the lowest y).
@@ -138,18 +127,9 @@ impl OccupancyGrid {
     ) -> Result<Self, GridError> {
         check_size(width, height, resolution)?;
         if cells.len() != width * height {
-            return Err(GridError::BadCellCount {
-                expected: width * height,
-                got: cells.len(),
-            });
+            return Err(GridError::BadCellCount { expected: width * height, got: cells.len() });
         }
-        Ok(OccupancyGrid {
-            resolution,
-            origin,
-            width,
-            height,
-            cells,
-        })
+        Ok(OccupancyGrid { resolution, origin, width, height, cells })
     }
 
     /// Width in cells.
@@ -202,8 +182,7 @@ impl OccupancyGrid {
     /// Log-odds of cell (ix, iy), or None off the grid.
     #[inline]
     pub fn get_checked(&self, ix: i64, iy: i64) -> Option<f32> {
-        self.contains_cell(ix, iy)
-            .then(|| self.cells[iy as usize * self.width + ix as usize])
+        self.contains_cell(ix, iy).then(|| self.cells[iy as usize * self.width + ix as usize])
     }
 
     /// Sets the log-odds of cell (ix, iy); panics off the grid.
@@ -258,14 +237,9 @@ impl OccupancyGrid {
         let mut b: Option<(usize, usize, usize, usize)> = None;
         for iy in 0..self.height {
             let row = &self.cells[iy * self.width..(iy + 1) * self.width];
-            let first = row
-                .iter()
-                .position(|&l| CellState::from_log_odds(l) != CellState::Unknown);
+            let first = row.iter().position(|&l| CellState::from_log_odds(l) != CellState::Unknown);
             if let Some(x0) = first {
-                let x1 = row
-                    .iter()
-                    .rposition(|&l| CellState::from_log_odds(l) != CellState::Unknown)
-                    .unwrap_or(x0);
+                let x1 = row.iter().rposition(|&l| CellState::from_log_odds(l) != CellState::Unknown).unwrap_or(x0);
                 b = Some(match b {
                     None => (x0, iy, x1, iy),
                     Some((a, by, c, _)) => (a.min(x0), by, c.max(x1), iy),
@@ -292,8 +266,7 @@ impl OccupancyGrid {
     /// The cell a map-frame point falls in, or None off the grid.
     pub fn world_to_cell(&self, p: &Point2<f64>) -> Option<(usize, usize)> {
         let (ix, iy) = self.world_to_cell_i(p);
-        self.contains_cell(ix, iy)
-            .then_some((ix as usize, iy as usize))
+        self.contains_cell(ix, iy).then_some((ix as usize, iy as usize))
     }
 
     /// Map-frame position of continuous cell coordinates.
@@ -310,13 +283,7 @@ impl OccupancyGrid {
 
     /// Grows the grid (unknown cells, plus a margin) so that the continuous cell box
     /// `[x0, x1] × [y0, y1]` of the current grid lies on it. Returns the cell shift applied to old indices.
-    pub fn grow_to_cells(
-        &mut self,
-        x0: f64,
-        y0: f64,
-        x1: f64,
-        y1: f64,
-    ) -> Result<(usize, usize), GridError> {
+    pub fn grow_to_cells(&mut self, x0: f64, y0: f64, x1: f64, y1: f64) -> Result<(usize, usize), GridError> {
         let (lo_x, lo_y) = (x0.floor() as i64, y0.floor() as i64);
         let (hi_x, hi_y) = (x1.floor() as i64, y1.floor() as i64);
         let (w, h) = (self.width as i64, self.height as i64);
@@ -325,16 +292,8 @@ impl OccupancyGrid {
         }
         let add_left = if lo_x < 0 { -lo_x + GROWTH_MARGIN } else { 0 };
         let add_bottom = if lo_y < 0 { -lo_y + GROWTH_MARGIN } else { 0 };
-        let add_right = if hi_x >= w {
-            hi_x - w + 1 + GROWTH_MARGIN
-        } else {
-            0
-        };
-        let add_top = if hi_y >= h {
-            hi_y - h + 1 + GROWTH_MARGIN
-        } else {
-            0
-        };
+        let add_right = if hi_x >= w { hi_x - w + 1 + GROWTH_MARGIN } else { 0 };
+        let add_top = if hi_y >= h { hi_y - h + 1 + GROWTH_MARGIN } else { 0 };
         let nw = (w + add_left + add_right) as usize;
         let nh = (h + add_bottom + add_top) as usize;
         check_size(nw, nh, self.resolution)?;
@@ -345,10 +304,8 @@ impl OccupancyGrid {
             let dst = (iy + sy) * nw + sx;
             cells[dst..dst + self.width].copy_from_slice(src);
         }
-        self.origin *= nalgebra::Translation2::new(
-            -(add_left as f64) * self.resolution,
-            -(add_bottom as f64) * self.resolution,
-        );
+        self.origin *=
+            nalgebra::Translation2::new(-(add_left as f64) * self.resolution, -(add_bottom as f64) * self.resolution);
         self.cells = cells;
         self.width = nw;
         self.height = nh;
@@ -417,11 +374,7 @@ impl OccupancyGrid {
             let end = trav.end_cell();
             for (cx, cy) in trav {
                 let idx = cy as usize * self.width + cx as usize;
-                let delta = if (cx, cy) == end {
-                    if hit { params.hit } else { params.miss }
-                } else {
-                    params.miss
-                };
+                let delta = if (cx, cy) == end { if hit { params.hit } else { params.miss } } else { params.miss };
                 self.cells[idx] = (self.cells[idx] + delta).clamp(lo, hi);
             }
         }
@@ -433,10 +386,7 @@ impl OccupancyGrid {
     pub fn cast_ray(&self, from: &Point2<f64>, angle: f64, max_range: f64) -> Option<f64> {
         let (x0, y0) = self.world_to_cell_f(from);
         let local = angle - self.origin.rotation.angle();
-        let (dx, dy) = (
-            local.cos() * max_range / self.resolution,
-            local.sin() * max_range / self.resolution,
-        );
+        let (dx, dy) = (local.cos() * max_range / self.resolution, local.sin() * max_range / self.resolution);
         let (x1, y1) = (x0 + dx, y0 + dy);
         let (w, h) = (self.width as i64, self.height as i64);
         for (cx, cy) in CellTraversal::new(x0, y0, x1, y1) {
@@ -516,10 +466,7 @@ mod tests {
 
     #[test]
     fn refuses_bad_sizes() {
-        assert_eq!(
-            OccupancyGrid::new(10, 10, 0.0, pose(0.0, 0.0, 0.0)),
-            Err(GridError::BadResolution(0.0))
-        );
+        assert_eq!(OccupancyGrid::new(10, 10, 0.0, pose(0.0, 0.0, 0.0)), Err(GridError::BadResolution(0.0)));
         assert!(matches!(
             OccupancyGrid::new(100_000, 100_000, 0.05, pose(0.0, 0.0, 0.0)),
             Err(GridError::TooLarge { .. })
@@ -567,15 +514,10 @@ mod tests {
             range_max: 4.0,
             ranges: vec![2.0, 4.0, f32::NAN],
         };
-        g.integrate_scan(&scan, &pose(0.55, 0.55, 0.0), &LogOddsParams::default())
-            .unwrap();
+        g.integrate_scan(&scan, &pose(0.55, 0.55, 0.0), &LogOddsParams::default()).unwrap();
         assert!(g.width() > 20, "grid grew to hold the 2 m beam");
         let hit = g.world_to_cell(&Point2::new(2.55, 0.55)).unwrap();
-        assert_eq!(
-            g.state(hit.0, hit.1),
-            CellState::Occupied,
-            "one hit gives p = 0.7 > 0.65"
-        );
+        assert_eq!(g.state(hit.0, hit.1), CellState::Occupied, "one hit gives p = 0.7 > 0.65");
         assert!(g.get(hit.0, hit.1) > 0.8);
         let free = g.world_to_cell(&Point2::new(1.5, 0.55)).unwrap();
         assert!(g.get(free.0, free.1) < 0.0);
@@ -590,8 +532,7 @@ mod tests {
         let mut g = OccupancyGrid::new(4, 4, 0.5, pose(1.0, 2.0, 0.3)).unwrap();
         g.set(1, 2, 2.0);
         let p = g.cell_center(1, 2);
-        g.grow_to_points(&[Point2::new(-10.0, -10.0), Point2::new(10.0, 10.0)])
-            .unwrap();
+        g.grow_to_points(&[Point2::new(-10.0, -10.0), Point2::new(10.0, 10.0)]).unwrap();
         let c = g.world_to_cell(&p).unwrap();
         assert_eq!(g.get(c.0, c.1), 2.0);
         assert!(g.world_to_cell(&Point2::new(-10.0, -10.0)).is_some());

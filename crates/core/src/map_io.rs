@@ -133,10 +133,7 @@ pub enum MapIoError {
 }
 
 fn io_err(path: &Path) -> impl FnOnce(std::io::Error) -> MapIoError + '_ {
-    move |cause| MapIoError::Io {
-        path: path.to_path_buf(),
-        cause,
-    }
+    move |cause| MapIoError::Io { path: path.to_path_buf(), cause }
 }
 
 /// A grey image with 8-bit pixels, row 0 at the top, as stored on disk.
@@ -156,20 +153,13 @@ pub fn read_ros_map(yaml_path: &Path) -> Result<OccupancyGrid, MapIoError> {
     let meta = parse_map_yaml(&text, yaml_path)?;
     let image_path = resolve_image_path(yaml_path, &meta.image);
     let img = read_grey_image(&image_path)?;
-    grid_from_image(&img, &meta).map_err(|cause| MapIoError::Grid {
-        path: yaml_path.to_path_buf(),
-        cause,
-    })
+    grid_from_image(&img, &meta).map_err(|cause| MapIoError::Grid { path: yaml_path.to_path_buf(), cause })
 }
 
 /// Resolves the YAML's `image` field against the YAML file's folder.
 pub fn resolve_image_path(yaml_path: &Path, image: &str) -> PathBuf {
     let p = Path::new(image);
-    if p.is_absolute() {
-        p.to_path_buf()
-    } else {
-        yaml_path.parent().unwrap_or(Path::new(".")).join(p)
-    }
+    if p.is_absolute() { p.to_path_buf() } else { yaml_path.parent().unwrap_or(Path::new(".")).join(p) }
 }
 
 /// Builds a grid from an image and its metadata, as map_server does.
@@ -190,11 +180,7 @@ pub fn grid_from_image(img: &GreyImage, meta: &MapYaml) -> Result<OccupancyGrid,
                     }
                 }
                 MapMode::Trinary | MapMode::Scale => {
-                    let p = if meta.negate {
-                        v as f64 / 255.0
-                    } else {
-                        (255.0 - v as f64) / 255.0
-                    };
+                    let p = if meta.negate { v as f64 / 255.0 } else { (255.0 - v as f64) / 255.0 };
                     if p > occ {
                         100
                     } else if p < free {
@@ -209,13 +195,7 @@ pub fn grid_from_image(img: &GreyImage, meta: &MapYaml) -> Result<OccupancyGrid,
             cells[iy * w + ix] = ros_to_log_odds(ros);
         }
     }
-    OccupancyGrid::from_cells(
-        w,
-        h,
-        meta.resolution,
-        pose(meta.origin[0], meta.origin[1], meta.origin[2]),
-        cells,
-    )
+    OccupancyGrid::from_cells(w, h, meta.resolution, pose(meta.origin[0], meta.origin[1], meta.origin[2]), cells)
 }
 
 /// Log-odds of a ROS occupancy value (−1 unknown, 0..100).
@@ -226,20 +206,14 @@ pub fn ros_to_log_odds(v: i32) -> f32 {
         100 => ROS_LOGODDS_LIMIT,
         v => {
             let p = v as f32 / 100.0;
-            (p / (1.0 - p))
-                .ln()
-                .clamp(-ROS_LOGODDS_LIMIT, ROS_LOGODDS_LIMIT)
+            (p / (1.0 - p)).ln().clamp(-ROS_LOGODDS_LIMIT, ROS_LOGODDS_LIMIT)
         }
     }
 }
 
 /// Parses the text of a map_server YAML file; `path` only names the file in errors.
 pub fn parse_map_yaml(text: &str, path: &Path) -> Result<MapYaml, MapIoError> {
-    let yaml_err = |line: usize, message: String| MapIoError::Yaml {
-        path: path.to_path_buf(),
-        line,
-        message,
-    };
+    let yaml_err = |line: usize, message: String| MapIoError::Yaml { path: path.to_path_buf(), line, message };
     let bad = |line: usize, field: &'static str, message: String| MapIoError::BadField {
         path: path.to_path_buf(),
         line,
@@ -262,10 +236,7 @@ pub fn parse_map_yaml(text: &str, path: &Path) -> Result<MapYaml, MapIoError> {
             continue;
         }
         let Some((key, value)) = line.split_once(':') else {
-            return Err(yaml_err(
-                line_no,
-                format!("expected `key: value`, found `{line}`"),
-            ));
+            return Err(yaml_err(line_no, format!("expected `key: value`, found `{line}`")));
         };
         let key = key.trim();
         let value = unquote(value.trim());
@@ -278,13 +249,7 @@ pub fn parse_map_yaml(text: &str, path: &Path) -> Result<MapYaml, MapIoError> {
                 .parse::<f64>()
                 .ok()
                 .filter(|v| v.is_finite())
-                .ok_or_else(|| {
-                    bad(
-                        line_no,
-                        field,
-                        format!("expected a finite number, found `{value}`"),
-                    )
-                })
+                .ok_or_else(|| bad(line_no, field, format!("expected a finite number, found `{value}`")))
         };
         match key {
             "image" => {
@@ -296,11 +261,7 @@ pub fn parse_map_yaml(text: &str, path: &Path) -> Result<MapYaml, MapIoError> {
             "resolution" => {
                 let r = number("resolution")?;
                 if r <= 0.0 {
-                    return Err(bad(
-                        line_no,
-                        "resolution",
-                        format!("must be positive, found {r}"),
-                    ));
+                    return Err(bad(line_no, "resolution", format!("must be positive, found {r}")));
                 }
                 resolution = Some((line_no, r));
             }
@@ -308,20 +269,10 @@ pub fn parse_map_yaml(text: &str, path: &Path) -> Result<MapYaml, MapIoError> {
                 let inner = value
                     .strip_prefix('[')
                     .and_then(|v| v.strip_suffix(']'))
-                    .ok_or_else(|| {
-                        bad(
-                            line_no,
-                            "origin",
-                            format!("expected `[x, y, yaw]`, found `{value}`"),
-                        )
-                    })?;
+                    .ok_or_else(|| bad(line_no, "origin", format!("expected `[x, y, yaw]`, found `{value}`")))?;
                 let parts: Vec<&str> = inner.split(',').map(str::trim).collect();
                 if parts.len() != 3 {
-                    return Err(bad(
-                        line_no,
-                        "origin",
-                        format!("expected 3 numbers, found {}", parts.len()),
-                    ));
+                    return Err(bad(line_no, "origin", format!("expected 3 numbers, found {}", parts.len())));
                 }
                 let mut o = [0.0; 3];
                 for (k, p) in parts.iter().enumerate() {
@@ -329,9 +280,7 @@ pub fn parse_map_yaml(text: &str, path: &Path) -> Result<MapYaml, MapIoError> {
                         .parse::<f64>()
                         .ok()
                         .filter(|v| v.is_finite())
-                        .ok_or_else(|| {
-                            bad(line_no, "origin", format!("`{p}` is not a finite number"))
-                        })?;
+                        .ok_or_else(|| bad(line_no, "origin", format!("`{p}` is not a finite number")))?;
                 }
                 origin = Some(o);
             }
@@ -340,11 +289,7 @@ pub fn parse_map_yaml(text: &str, path: &Path) -> Result<MapYaml, MapIoError> {
                     "0" | "false" | "False" => false,
                     "1" | "true" | "True" => true,
                     _ => {
-                        return Err(bad(
-                            line_no,
-                            "negate",
-                            format!("expected 0 or 1, found `{value}`"),
-                        ));
+                        return Err(bad(line_no, "negate", format!("expected 0 or 1, found `{value}`")));
                     }
                 }
             }
@@ -362,33 +307,22 @@ pub fn parse_map_yaml(text: &str, path: &Path) -> Result<MapYaml, MapIoError> {
                     "scale" => MapMode::Scale,
                     "raw" => MapMode::Raw,
                     _ => {
-                        return Err(bad(
-                            line_no,
-                            "mode",
-                            format!("expected trinary, scale or raw, found `{value}`"),
-                        ));
+                        return Err(bad(line_no, "mode", format!("expected trinary, scale or raw, found `{value}`")));
                     }
                 }
             }
             _ => {} // map_server ignores fields it does not know; so do we.
         }
     }
-    if !(0.0..=1.0).contains(&free_thresh)
-        || !(0.0..=1.0).contains(&occupied_thresh)
-        || free_thresh >= occupied_thresh
+    if !(0.0..=1.0).contains(&free_thresh) || !(0.0..=1.0).contains(&occupied_thresh) || free_thresh >= occupied_thresh
     {
         return Err(bad(
             thresh_line,
             "free_thresh",
-            format!(
-                "need 0 <= free_thresh < occupied_thresh <= 1, found {free_thresh} and {occupied_thresh}"
-            ),
+            format!("need 0 <= free_thresh < occupied_thresh <= 1, found {free_thresh} and {occupied_thresh}"),
         ));
     }
-    let missing = |field| MapIoError::MissingField {
-        path: path.to_path_buf(),
-        field,
-    };
+    let missing = |field| MapIoError::MissingField { path: path.to_path_buf(), field };
     Ok(MapYaml {
         image: image.ok_or_else(|| missing("image"))?,
         resolution: resolution.ok_or_else(|| missing("resolution"))?.1,
@@ -430,50 +364,27 @@ pub fn read_grey_image(path: &Path) -> Result<GreyImage, MapIoError> {
     if bytes.first() == Some(&b'P') {
         return parse_pgm(&bytes, path);
     }
-    let reader = image::ImageReader::new(std::io::Cursor::new(&bytes))
-        .with_guessed_format()
-        .map_err(io_err(path))?;
-    let (w, h) = reader.into_dimensions().map_err(|e| MapIoError::Image {
-        path: path.to_path_buf(),
-        message: e.to_string(),
-    })?;
+    let reader = image::ImageReader::new(std::io::Cursor::new(&bytes)).with_guessed_format().map_err(io_err(path))?;
+    let (w, h) =
+        reader.into_dimensions().map_err(|e| MapIoError::Image { path: path.to_path_buf(), message: e.to_string() })?;
     let (w, h) = (w as usize, h as usize);
     if w.saturating_mul(h) > MAX_CELLS {
-        return Err(MapIoError::TooLarge {
-            path: path.to_path_buf(),
-            width: w,
-            height: h,
-        });
+        return Err(MapIoError::TooLarge { path: path.to_path_buf(), width: w, height: h });
     }
     let img = image::ImageReader::new(std::io::Cursor::new(&bytes))
         .with_guessed_format()
         .map_err(io_err(path))?
         .decode()
-        .map_err(|e| MapIoError::Image {
-            path: path.to_path_buf(),
-            message: e.to_string(),
-        })?;
+        .map_err(|e| MapIoError::Image { path: path.to_path_buf(), message: e.to_string() })?;
     let rgb = img.to_rgb8();
-    let pixels = rgb
-        .pixels()
-        .map(|p| ((p[0] as u16 + p[1] as u16 + p[2] as u16) / 3) as u8)
-        .collect();
-    Ok(GreyImage {
-        width: w,
-        height: h,
-        pixels,
-    })
+    let pixels = rgb.pixels().map(|p| ((p[0] as u16 + p[1] as u16 + p[2] as u16) / 3) as u8).collect();
+    Ok(GreyImage { width: w, height: h, pixels })
 }
 
 /// Parses a PGM file's bytes.
 pub fn parse_pgm(bytes: &[u8], path: &Path) -> Result<GreyImage, MapIoError> {
-    let err = |message: String| MapIoError::Pgm {
-        path: path.to_path_buf(),
-        message,
-    };
-    let magic = bytes
-        .get(..2)
-        .ok_or_else(|| err("file too short for a header".into()))?;
+    let err = |message: String| MapIoError::Pgm { path: path.to_path_buf(), message };
+    let magic = bytes.get(..2).ok_or_else(|| err("file too short for a header".into()))?;
     let binary = match magic {
         b"P5" => true,
         b"P2" => false,
@@ -487,8 +398,7 @@ pub fn parse_pgm(bytes: &[u8], path: &Path) -> Result<GreyImage, MapIoError> {
     let mut pos = 2;
     let mut header = [0usize; 3];
     for (k, name) in ["width", "height", "maxval"].iter().enumerate() {
-        header[k] = next_number(bytes, &mut pos)
-            .ok_or_else(|| err(format!("missing or bad {name} in header")))?;
+        header[k] = next_number(bytes, &mut pos).ok_or_else(|| err(format!("missing or bad {name} in header")))?;
     }
     let [w, h, maxval] = header;
     if w == 0 || h == 0 {
@@ -498,11 +408,7 @@ pub fn parse_pgm(bytes: &[u8], path: &Path) -> Result<GreyImage, MapIoError> {
         return Err(err(format!("maxval {maxval} outside 1..65535")));
     }
     if w.saturating_mul(h) > MAX_CELLS {
-        return Err(MapIoError::TooLarge {
-            path: path.to_path_buf(),
-            width: w,
-            height: h,
-        });
+        return Err(MapIoError::TooLarge { path: path.to_path_buf(), width: w, height: h });
     }
     let n = w * h;
     let scale = |v: usize| -> u8 { ((v.min(maxval) * 255 + maxval / 2) / maxval) as u8 };
@@ -512,36 +418,21 @@ pub fn parse_pgm(bytes: &[u8], path: &Path) -> Result<GreyImage, MapIoError> {
         let bpp = if maxval > 255 { 2 } else { 1 };
         let data = bytes.get(pos..).unwrap_or(&[]);
         if data.len() < n * bpp {
-            return Err(err(format!(
-                "truncated: {} of {} pixel bytes present",
-                data.len(),
-                n * bpp
-            )));
+            return Err(err(format!("truncated: {} of {} pixel bytes present", data.len(), n * bpp)));
         }
         if bpp == 1 {
             pixels.extend(data[..n].iter().map(|&v| scale(v as usize)));
         } else {
-            pixels.extend(
-                data[..2 * n]
-                    .chunks_exact(2)
-                    .map(|c| scale(((c[0] as usize) << 8) | c[1] as usize)),
-            );
+            pixels.extend(data[..2 * n].chunks_exact(2).map(|c| scale(((c[0] as usize) << 8) | c[1] as usize)));
         }
     } else {
         for k in 0..n {
-            let v = next_number(bytes, &mut pos).ok_or_else(|| {
-                err(format!(
-                    "truncated: pixel {k} of {n} missing or not a number"
-                ))
-            })?;
+            let v = next_number(bytes, &mut pos)
+                .ok_or_else(|| err(format!("truncated: pixel {k} of {n} missing or not a number")))?;
             pixels.push(scale(v));
         }
     }
-    Ok(GreyImage {
-        width: w,
-        height: h,
-        pixels,
-    })
+    Ok(GreyImage { width: w, height: h, pixels })
 }
 
 /// Reads the next whitespace-separated decimal number, skipping `#` comments.
@@ -581,20 +472,12 @@ pub fn grid_to_image(grid: &OccupancyGrid) -> GreyImage {
             };
         }
     }
-    GreyImage {
-        width: w,
-        height: h,
-        pixels,
-    }
+    GreyImage { width: w, height: h, pixels }
 }
 
 /// Encodes a grey image as binary PGM (P5).
 pub fn encode_pgm(img: &GreyImage) -> Vec<u8> {
-    let mut out = format!(
-        "P5\n# written by mrslam\n{} {}\n255\n",
-        img.width, img.height
-    )
-    .into_bytes();
+    let mut out = format!("P5\n# written by mrslam\n{} {}\n255\n", img.width, img.height).into_bytes();
     out.extend_from_slice(&img.pixels);
     out
 }
@@ -603,15 +486,9 @@ pub fn encode_pgm(img: &GreyImage) -> Vec<u8> {
 pub fn encode_png(img: &GreyImage, path: &Path) -> Result<Vec<u8>, MapIoError> {
     let mut out = Vec::new();
     let buf = image::GrayImage::from_raw(img.width as u32, img.height as u32, img.pixels.clone())
-        .ok_or_else(|| MapIoError::Image {
-        path: path.to_path_buf(),
-        message: "pixel count mismatch".into(),
-    })?;
+        .ok_or_else(|| MapIoError::Image { path: path.to_path_buf(), message: "pixel count mismatch".into() })?;
     buf.write_to(&mut std::io::Cursor::new(&mut out), image::ImageFormat::Png)
-        .map_err(|e| MapIoError::Image {
-            path: path.to_path_buf(),
-            message: e.to_string(),
-        })?;
+        .map_err(|e| MapIoError::Image { path: path.to_path_buf(), message: e.to_string() })?;
     Ok(out)
 }
 
@@ -621,11 +498,7 @@ pub fn encode_png(img: &GreyImage, path: &Path) -> Result<Vec<u8>, MapIoError> {
 /// sees a half-written map.
 pub fn write_ros_map(grid: &OccupancyGrid, yaml_path: &Path) -> Result<(), MapIoError> {
     let pgm_path = yaml_path.with_extension("pgm");
-    let image_name = pgm_path
-        .file_name()
-        .and_then(|s| s.to_str())
-        .unwrap_or("map.pgm")
-        .to_string();
+    let image_name = pgm_path.file_name().and_then(|s| s.to_str()).unwrap_or("map.pgm").to_string();
     write_file_atomic(&pgm_path, &encode_pgm(&grid_to_image(grid)))?;
     write_file_atomic(yaml_path, map_yaml_text(grid, &image_name).as_bytes())
 }
@@ -637,13 +510,7 @@ pub fn map_yaml_text(grid: &OccupancyGrid, image_name: &str) -> String {
     let _ = writeln!(s, "image: {image_name}");
     let _ = writeln!(s, "mode: trinary");
     let _ = writeln!(s, "resolution: {}", grid.resolution());
-    let _ = writeln!(
-        s,
-        "origin: [{}, {}, {}]",
-        o.translation.x,
-        o.translation.y,
-        o.rotation.angle()
-    );
+    let _ = writeln!(s, "origin: [{}, {}, {}]", o.translation.x, o.translation.y, o.rotation.angle());
     let _ = writeln!(s, "negate: 0");
     let _ = writeln!(s, "occupied_thresh: 0.65");
     let _ = writeln!(s, "free_thresh: 0.196");
@@ -652,14 +519,8 @@ pub fn map_yaml_text(grid: &OccupancyGrid, image_name: &str) -> String {
 
 /// Writes `bytes` to `path` through a temporary file in the same folder and a rename.
 pub fn write_file_atomic(path: &Path, bytes: &[u8]) -> Result<(), MapIoError> {
-    let dir = path
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    let name = path
-        .file_name()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_default();
+    let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let name = path.file_name().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
     let tmp = dir.join(format!(".{name}.tmp{}", std::process::id()));
     let result = (|| {
         let mut f = std::fs::File::create(&tmp)?;
@@ -669,10 +530,7 @@ pub fn write_file_atomic(path: &Path, bytes: &[u8]) -> Result<(), MapIoError> {
     })();
     if let Err(cause) = result {
         let _ = std::fs::remove_file(&tmp);
-        return Err(MapIoError::Io {
-            path: path.to_path_buf(),
-            cause,
-        });
+        return Err(MapIoError::Io { path: path.to_path_buf(), cause });
     }
     Ok(())
 }
@@ -735,8 +593,7 @@ mod tests {
             ranges: vec![0.8; 40],
         };
         for _ in 0..3 {
-            g.integrate_scan(&scan, &pose(0.5, 0.5, 0.3), &LogOddsParams::default())
-                .unwrap();
+            g.integrate_scan(&scan, &pose(0.5, 0.5, 0.3), &LogOddsParams::default()).unwrap();
         }
         let dir = tempfile::tempdir().unwrap();
         let p = dir.path().join("m.yaml");
@@ -756,19 +613,14 @@ mod tests {
         let p5 = [b"P5\n4 1\n255\n".as_slice(), &[0u8, 100, 205, 255]].concat();
         write(dir.path(), "b.pgm", &p5);
         write(dir.path(), "a.pgm", b"P2\n# ascii\n4 1\n15\n0 6 12 15\n");
-        let meta =
-            "resolution: 0.1\norigin: [0, 0, 0]\noccupied_thresh: 0.65\nfree_thresh: 0.196\n";
+        let meta = "resolution: 0.1\norigin: [0, 0, 0]\noccupied_thresh: 0.65\nfree_thresh: 0.196\n";
         for (img, negate, expect) in [
             ("b.pgm", 0, [100, -1, -1, 0]),
             ("b.pgm", 1, [0, -1, 100, 100]),
             // maxval 15: 0 6 12 15 scale to 0 102 204 255, p = 1, .6, .2, 0
             ("a.pgm", 0, [100, -1, -1, 0]),
         ] {
-            let y = write(
-                dir.path(),
-                "m.yaml",
-                format!("image: {img}\nnegate: {negate}\n{meta}").as_bytes(),
-            );
+            let y = write(dir.path(), "m.yaml", format!("image: {img}\nnegate: {negate}\n{meta}").as_bytes());
             let g = read_ros_map(&y).unwrap();
             let got: Vec<i8> = g
                 .to_ros_int8()
@@ -791,28 +643,12 @@ mod tests {
     #[test]
     fn scale_and_raw_modes() {
         let dir = tempfile::tempdir().unwrap();
-        write(
-            dir.path(),
-            "r.pgm",
-            &[b"P5 3 1 255\n".as_slice(), &[0u8, 100, 255]].concat(),
-        );
-        let y = write(
-            dir.path(),
-            "r.yaml",
-            b"image: r.pgm\nresolution: 1\norigin: [0,0,0]\nmode: raw\n",
-        );
+        write(dir.path(), "r.pgm", &[b"P5 3 1 255\n".as_slice(), &[0u8, 100, 255]].concat());
+        let y = write(dir.path(), "r.yaml", b"image: r.pgm\nresolution: 1\norigin: [0,0,0]\nmode: raw\n");
         let g = read_ros_map(&y).unwrap();
         assert_eq!(g.to_ros_int8(), vec![0, 100, -1]);
-        write(
-            dir.path(),
-            "s.pgm",
-            &[b"P5 3 1 255\n".as_slice(), &[0u8, 110, 255]].concat(),
-        );
-        let y = write(
-            dir.path(),
-            "s.yaml",
-            b"image: s.pgm\nresolution: 1\norigin: [0,0,0]\nmode: scale\n",
-        );
+        write(dir.path(), "s.pgm", &[b"P5 3 1 255\n".as_slice(), &[0u8, 110, 255]].concat());
+        let y = write(dir.path(), "s.yaml", b"image: s.pgm\nresolution: 1\norigin: [0,0,0]\nmode: scale\n");
         let g = read_ros_map(&y).unwrap();
         let v = g.to_ros_int8();
         assert_eq!((v[0], v[2]), (100, 0));
@@ -821,35 +657,20 @@ mod tests {
 
     #[test]
     fn yaml_errors_name_line_and_field() {
-        let e = yaml("image: m.pgm\norigin: [0, 0, 0]\n")
-            .unwrap_err()
-            .to_string();
-        assert!(
-            e.contains("m.yaml") && e.contains("missing required field `resolution`"),
-            "{e}"
-        );
-        let e = yaml("image: m.pgm\nresolution: -0.05\norigin: [0, 0, 0]\n")
-            .unwrap_err()
-            .to_string();
-        assert!(
-            e.contains("m.yaml:2") && e.contains("`resolution`") && e.contains("positive"),
-            "{e}"
-        );
-        let e = yaml("image: m.pgm\nresolution: 0\norigin: [0, 0, 0]\n")
-            .unwrap_err()
-            .to_string();
+        let e = yaml("image: m.pgm\norigin: [0, 0, 0]\n").unwrap_err().to_string();
+        assert!(e.contains("m.yaml") && e.contains("missing required field `resolution`"), "{e}");
+        let e = yaml("image: m.pgm\nresolution: -0.05\norigin: [0, 0, 0]\n").unwrap_err().to_string();
+        assert!(e.contains("m.yaml:2") && e.contains("`resolution`") && e.contains("positive"), "{e}");
+        let e = yaml("image: m.pgm\nresolution: 0\norigin: [0, 0, 0]\n").unwrap_err().to_string();
         assert!(e.contains("m.yaml:2"), "{e}");
-        let e = yaml("image: m.pgm\nresolution: 0.05\norigin: [0, 0]\n")
-            .unwrap_err()
-            .to_string();
+        let e = yaml("image: m.pgm\nresolution: 0.05\norigin: [0, 0]\n").unwrap_err().to_string();
         assert!(e.contains("m.yaml:3") && e.contains("`origin`"), "{e}");
-        let e = yaml("image: m.pgm\nresolution: abc\n")
-            .unwrap_err()
-            .to_string();
+        let e = yaml("image: m.pgm\nresolution: abc\n").unwrap_err().to_string();
         assert!(e.contains("m.yaml:2") && e.contains("finite number"), "{e}");
         let e = yaml("# c\nimage m.pgm\n").unwrap_err().to_string();
         assert!(e.contains("m.yaml:2") && e.contains("key: value"), "{e}");
-        let ok = yaml("image: 'my map.pgm'  # the map\nresolution: 0.05\norigin: [1, 2, 0.5]\nmode: trinary\n").unwrap();
+        let ok =
+            yaml("image: 'my map.pgm'  # the map\nresolution: 0.05\norigin: [1, 2, 0.5]\nmode: trinary\n").unwrap();
         assert_eq!(ok.image, "my map.pgm");
         assert_eq!(ok.origin, [1.0, 2.0, 0.5]);
     }
@@ -857,51 +678,28 @@ mod tests {
     #[test]
     fn image_errors_name_the_file() {
         let dir = tempfile::tempdir().unwrap();
-        let y = write(
-            dir.path(),
-            "m.yaml",
-            b"image: gone.pgm\nresolution: 0.05\norigin: [0, 0, 0]\n",
-        );
+        let y = write(dir.path(), "m.yaml", b"image: gone.pgm\nresolution: 0.05\norigin: [0, 0, 0]\n");
         let e = read_ros_map(&y).unwrap_err().to_string();
         assert!(e.contains("gone.pgm"), "{e}");
         write(dir.path(), "bad.pgm", b"P6\n1 1\n255\n\0\0\0");
-        let e = read_grey_image(&dir.path().join("bad.pgm"))
-            .unwrap_err()
-            .to_string();
+        let e = read_grey_image(&dir.path().join("bad.pgm")).unwrap_err().to_string();
         assert!(e.contains("bad.pgm") && e.contains("P6"), "{e}");
         write(dir.path(), "short.pgm", b"P5\n10 10\n255\n\0\0\0");
-        let e = read_grey_image(&dir.path().join("short.pgm"))
-            .unwrap_err()
-            .to_string();
+        let e = read_grey_image(&dir.path().join("short.pgm")).unwrap_err().to_string();
         assert!(e.contains("truncated: 3 of 100"), "{e}");
         write(dir.path(), "short2.pgm", b"P2\n2 2\n255\n1 2 3");
-        let e = read_grey_image(&dir.path().join("short2.pgm"))
-            .unwrap_err()
-            .to_string();
+        let e = read_grey_image(&dir.path().join("short2.pgm")).unwrap_err().to_string();
         assert!(e.contains("truncated"), "{e}");
         // A header claiming 1e6 x 1e6 pixels is refused before any allocation.
         write(dir.path(), "huge.pgm", b"P5\n1000000 1000000\n255\n\0");
         let e = read_grey_image(&dir.path().join("huge.pgm")).unwrap_err();
-        assert!(
-            matches!(
-                e,
-                MapIoError::TooLarge {
-                    width: 1_000_000,
-                    ..
-                }
-            ),
-            "{e}"
-        );
+        assert!(matches!(e, MapIoError::TooLarge { width: 1_000_000, .. }), "{e}");
     }
 
     #[test]
     fn reads_png_maps() {
         let dir = tempfile::tempdir().unwrap();
-        let img = GreyImage {
-            width: 2,
-            height: 2,
-            pixels: vec![0, 254, 205, 254],
-        };
+        let img = GreyImage { width: 2, height: 2, pixels: vec![0, 254, 205, 254] };
         let p = dir.path().join("m.png");
         std::fs::write(&p, encode_png(&img, &p).unwrap()).unwrap();
         assert_eq!(read_grey_image(&p).unwrap(), img);

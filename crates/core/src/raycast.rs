@@ -95,11 +95,7 @@ impl Iterator for CellTraversal {
     }
 
     fn size_hint(&self) -> (usize, Option<usize>) {
-        let n = if self.done {
-            0
-        } else {
-            self.remaining as usize + 1
-        };
+        let n = if self.done { 0 } else { self.remaining as usize + 1 };
         (n, Some(n))
     }
 }

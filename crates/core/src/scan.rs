@@ -63,10 +63,7 @@ impl LaserScan {
     }
 
     /// End points of the valid beams, with their beam index, in the frame of `sensor_pose`.
-    pub fn endpoints<'a>(
-        &'a self,
-        sensor_pose: &'a Pose2,
-    ) -> impl Iterator<Item = (usize, Point2<f64>)> + 'a {
+    pub fn endpoints<'a>(&'a self, sensor_pose: &'a Pose2) -> impl Iterator<Item = (usize, Point2<f64>)> + 'a {
         (0..self.len())
             .filter(|&i| self.is_valid(i))
             .map(move |i| (i, self.point_at(sensor_pose, i, self.ranges[i] as f64)))

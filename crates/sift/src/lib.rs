@@ -1,1 +1,288 @@
-//! SIFT keypoints and descriptors on grey f32 images.
+//! SIFT keypoints and descriptors on grey f32 images, faithful to Lowe (2004) and OpenCV 4.x
+//! (`features2d/src/sift.simd.hpp`, float path).
+//!
+//! Grey image in (values 0..255 like an 8-bit image), keypoints (OpenCV conventions: pixel centres at
+//! integer coordinates, angle in degrees, packed octave) and 128-byte descriptors out. This crate knows
+//! nothing of maps.
+//!
+//! ```
+//! use mrslam_sift::{GrayImage, SiftParams, detect_and_compute};
+//! let img = GrayImage::new(64, 64, vec![128.0; 64 * 64]).unwrap();
+//! let f = detect_and_compute(&img, &SiftParams::default());
+//! assert_eq!(f.len(), 0); // a flat image has no keypoint
+//! ```
+
+#![warn(missing_docs)]
+
+mod blur;
+mod descriptor;
+mod error;
+mod extrema;
+mod fastmath;
+mod image;
+mod keypoint;
+mod orientation;
+mod params;
+mod pyramid;
+
+pub use error::SiftError;
+pub use image::GrayImage;
+pub use keypoint::{DESCRIPTOR_LEN, Features, Keypoint};
+pub use params::SiftParams;
+
+use descriptor::DescScratch;
+use extrema::{Candidate, DogRows, DogView, find_candidates, refine};
+use orientation::{ORI_HIST_BINS, ORI_RADIUS, ORI_SIG_FCTR, OriScratch, orientation_hist, peak_angles};
+use pyramid::Octave;
+use rayon::prelude::*;
+use std::cmp::Ordering;
+
+/// Largest supported `n_octave_layers` (the layer is packed into 8 bits of `Keypoint::octave`).
+pub const MAX_OCTAVE_LAYERS: usize = 250;
+
+/// Detects keypoints and computes their descriptors (one-shot form of [`Sift::detect_and_compute`]).
+pub fn detect_and_compute(img: &GrayImage, params: &SiftParams) -> Features {
+    Sift::new(params.clone()).detect_and_compute(img)
+}
+
+/// A SIFT detector holding its scratch buffers, to be reused across images.
+#[derive(Debug)]
+pub struct Sift {
+    params: SiftParams,
+    octave: Octave,
+    candidates: Vec<Candidate>,
+    dog_rows: DogRows,
+    ori: OriScratch,
+    desc: DescScratch,
+}
+
+/// A keypoint with its descriptor, before deduplication.
+type Found = (Keypoint, [u8; DESCRIPTOR_LEN]);
+
+impl Sift {
+    /// A detector with these parameters.
+    pub fn new(params: SiftParams) -> Self {
+        Self {
+            params,
+            octave: Octave::default(),
+            candidates: Vec::new(),
+            dog_rows: DogRows::default(),
+            ori: OriScratch::default(),
+            desc: DescScratch::default(),
+        }
+    }
+
+    /// The parameters in use.
+    pub fn params(&self) -> &SiftParams {
+        &self.params
+    }
+
+    /// Detects keypoints and computes descriptors. Never panics: empty or tiny images and unusable
+    /// parameters (no layer, non-positive or non-finite sigma) give no keypoints.
+    ///
+    /// Output order is OpenCV's after `removeDuplicatedSorted` (x, then y ascending, larger size first,
+    /// ...); with `max_features` the strongest responses are kept, strongest first (ties keep that order).
+    pub fn detect_and_compute(&mut self, img: &GrayImage) -> Features {
+        let p = self.params.clone();
+        let (w, h) = (img.width, img.height);
+        if w == 0 || h == 0 || img.data.len() != w * h || !params_usable(&p) {
+            return Features::default();
+        }
+        let first_octave: i32 = if p.upscale { -1 } else { 0 };
+        let (bw, bh) = if p.upscale { (2 * w, 2 * h) } else { (w, h) };
+        let n_octaves = match p.n_octaves {
+            Some(n) => n as i64,
+            None => (((bw.min(bh) as f64).ln() / 2f64.ln()) - 2.0).round_ties_even() as i64 - i64::from(first_octave),
+        };
+        if n_octaves <= 0 {
+            return Features::default();
+        }
+        let threshold = p.pre_threshold();
+        self.octave.prepare(&p);
+        self.octave.init_base(&img.data, w, h, &p);
+        let mut found: Vec<Found> = Vec::new();
+        for o in 0..n_octaves as usize {
+            if o > 0 && !self.octave.next_base(p.n_octave_layers) {
+                break;
+            }
+            if o >= 31 {
+                break;
+            }
+            let (ow, oh) = (self.octave.w, self.octave.h);
+            self.candidates.clear();
+            let (cands, ring) = (&mut self.candidates, &mut self.dog_rows);
+            let n_layers = p.n_octave_layers;
+            let scan = |g: &[Vec<f32>], r0: usize, r1: usize| {
+                find_candidates(g, ow, oh, n_layers, threshold, p.border, r0..r1, ring, cands)
+            };
+            if p.parallel {
+                self.octave.build(true);
+                let mut scan = scan;
+                scan(&self.octave.gauss, 0, oh);
+            } else {
+                self.octave.build_scan(scan);
+            }
+            let oct = &self.octave;
+            if p.parallel {
+                let per: Vec<Vec<Found>> = self
+                    .candidates
+                    .par_iter()
+                    .map_init(
+                        || (OriScratch::default(), DescScratch::default(), Vec::new()),
+                        |(ori, desc, angles), &cand| {
+                            let mut v = Vec::new();
+                            process_candidate(oct, o, cand, &p, ori, desc, angles, &mut v);
+                            v
+                        },
+                    )
+                    .collect();
+                found.extend(per.into_iter().flatten());
+            } else {
+                let mut angles = Vec::new();
+                for &cand in &self.candidates {
+                    process_candidate(oct, o, cand, &p, &mut self.ori, &mut self.desc, &mut angles, &mut found);
+                }
+            }
+        }
+        // Back to input-image coordinates (OpenCV: firstOctave = -1 halves positions and sizes).
+        if first_octave < 0 {
+            for (kp, _) in &mut found {
+                kp.octave = (kp.octave & !255) | ((kp.octave + first_octave) & 255);
+                kp.x *= 0.5;
+                kp.y *= 0.5;
+                kp.size *= 0.5;
+            }
+        }
+        // OpenCV KeyPointsFilter::removeDuplicatedSorted.
+        found.sort_by(|a, b| keypoint_order(&a.0, &b.0));
+        found.dedup_by(|b, a| a.0.x == b.0.x && a.0.y == b.0.y && a.0.size == b.0.size && a.0.angle == b.0.angle);
+        if let Some(max) = p.max_features
+            && found.len() > max
+        {
+            found.sort_by(|a, b| b.0.response.total_cmp(&a.0.response));
+            found.truncate(max);
+        }
+        let mut out = Features {
+            keypoints: Vec::with_capacity(found.len()),
+            descriptors: Vec::with_capacity(found.len() * DESCRIPTOR_LEN),
+        };
+        for (kp, d) in found {
+            out.keypoints.push(kp);
+            out.descriptors.extend_from_slice(&d);
+        }
+        out
+    }
+}
+
+fn params_usable(p: &SiftParams) -> bool {
+    let pos = |v: f32| v.is_finite() && v > 0.0;
+    (1..=MAX_OCTAVE_LAYERS).contains(&p.n_octave_layers)
+        && pos(p.sigma)
+        && p.init_sigma.is_finite()
+        && p.init_sigma >= 0.0
+        && p.contrast_threshold.is_finite()
+        && p.edge_threshold.is_finite()
+        && p.border >= 1
+}
+
+/// OpenCV `KeyPoint_LessThan`: x, y ascending, size descending, angle ascending, response descending,
+/// octave descending.
+fn keypoint_order(a: &Keypoint, b: &Keypoint) -> Ordering {
+    a.x.total_cmp(&b.x)
+        .then(a.y.total_cmp(&b.y))
+        .then(b.size.total_cmp(&a.size))
+        .then(a.angle.total_cmp(&b.angle))
+        .then(b.response.total_cmp(&a.response))
+        .then(b.octave.cmp(&a.octave))
+}
+
+/// Refines one candidate, assigns its orientations and computes one descriptor per orientation.
+#[allow(clippy::too_many_arguments)]
+fn process_candidate(
+    oct: &Octave,
+    o: usize,
+    cand: Candidate,
+    p: &SiftParams,
+    ori: &mut OriScratch,
+    desc: &mut DescScratch,
+    angles: &mut Vec<f32>,
+    out: &mut Vec<Found>,
+) {
+    let (w, h) = (oct.w, oct.h);
+    let Some(rf) = refine(DogView { gauss: &oct.gauss, w }, w, h, cand, p) else {
+        return;
+    };
+    let n_layers = p.n_octave_layers;
+    let octv_scale = (1u32 << o) as f32;
+    let base = Keypoint {
+        x: (rf.c as f32 + rf.xc) * octv_scale,
+        y: (rf.r as f32 + rf.xr) * octv_scale,
+        size: p.sigma * 2f32.powf((rf.layer as f32 + rf.xi) / n_layers as f32) * octv_scale * 2.0,
+        angle: 0.0,
+        response: rf.contr.abs(),
+        octave: o as i32
+            + ((rf.layer as i32) << 8)
+            + ((((f64::from(rf.xi) + 0.5) * 255.0).round_ties_even() as i32) << 16),
+    };
+    let scl_octv = base.size * 0.5 / octv_scale;
+    let gauss = oct.layer(rf.layer);
+    let mut hist = [0.0f32; ORI_HIST_BINS];
+    let omax = orientation_hist(
+        gauss,
+        w,
+        h,
+        rf.c,
+        rf.r,
+        (ORI_RADIUS * scl_octv).round_ties_even() as i32,
+        ORI_SIG_FCTR * scl_octv,
+        &mut hist,
+        ori,
+    );
+    angles.clear();
+    peak_angles(&hist, omax, angles);
+    let (px, py) = (rf.c as f32 + rf.xc, rf.r as f32 + rf.xr);
+    for &angle in angles.iter() {
+        let kp = Keypoint { angle, ..base };
+        let mut d_angle = 360.0 - angle;
+        if (d_angle - 360.0).abs() < f32::EPSILON {
+            d_angle = 0.0;
+        }
+        let mut d = [0u8; DESCRIPTOR_LEN];
+        descriptor::descriptor(gauss, w, h, px, py, d_angle, scl_octv, &mut d, desc);
+        out.push((kp, d));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tiny_and_empty_images_give_nothing() {
+        for (w, h) in [(0, 0), (0, 5), (5, 0), (1, 1), (2, 2), (3, 3), (7, 5), (16, 1)] {
+            let data: Vec<f32> = (0..w * h).map(|i| (i * 37 % 255) as f32).collect();
+            let img = GrayImage::new(w, h, data).unwrap();
+            for upscale in [true, false] {
+                let f = detect_and_compute(&img, &SiftParams { upscale, ..Default::default() });
+                assert!(f.is_empty(), "{w}x{h}");
+                assert!(f.descriptors.is_empty());
+            }
+        }
+    }
+
+    #[test]
+    fn bad_params_give_nothing() {
+        let data: Vec<f32> = (0..64 * 64).map(|i| ((i * 7919) % 255) as f32).collect();
+        let img = GrayImage::new(64, 64, data).unwrap();
+        for p in [
+            SiftParams { n_octave_layers: 0, ..Default::default() },
+            SiftParams { sigma: 0.0, ..Default::default() },
+            SiftParams { sigma: f32::NAN, ..Default::default() },
+            SiftParams { n_octaves: Some(0), ..Default::default() },
+        ] {
+            assert!(detect_and_compute(&img, &p).is_empty());
+        }
+        let many = SiftParams { n_octaves: Some(40), ..Default::default() };
+        let _ = detect_and_compute(&img, &many);
+    }
+}

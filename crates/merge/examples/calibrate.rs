@@ -1,0 +1,68 @@
+//! Measures what the merger's defaults rest on: success and false-merge rates of both map encodings on
+//! generated floor-plan pairs, with the verification statistics of correct and wrong answers.
+//!
+//! `cargo run --release -p mrslam-merge --example calibrate -- [PAIRS]`
+
+use mrslam_merge::floorplan::{FloorplanParams, generate};
+use mrslam_merge::pairs::{PairSpec, cut_pair};
+use mrslam_merge::{MapEncoding, MergeParams, SiftMerger, SiftMergerParams, merge};
+
+fn main() {
+    let n: u64 = std::env::args().nth(1).and_then(|s| s.parse().ok()).unwrap_or(40);
+    let raw = MergeParams { verify_enabled: false, ..MergeParams::default() };
+    for (name, enc) in [("walls", MapEncoding::WALLS), ("paper", MapEncoding::PAPER)] {
+        let merger = SiftMerger::new(SiftMergerParams { encoding: enc, ..Default::default() });
+        for overlap in [-0.1, 0.1, 0.2, 0.3, 0.5] {
+            let (mut correct, mut accepted_ok, mut accepted_wrong) = (0, 0, 0);
+            let mut stats_wrong: Vec<(usize, usize, f64, usize, f64)> = Vec::new();
+            let mut stats_ok: Vec<(usize, usize, f64, usize, f64)> = Vec::new();
+            let mut time = 0.0;
+            for s in 0..n {
+                let map = generate(1000 + s, &FloorplanParams::default());
+                let pair = cut_pair(&map, &PairSpec { overlap, ..Default::default() }, s);
+                let out = merge(&merger, &pair.a, &pair.b, &raw);
+                time += out.report.time_ms;
+                let gated = merge(&merger, &pair.a, &pair.b, &MergeParams::default()).report.accepted;
+                let Some(t) = out.report.transform else { continue };
+                let est = t.to_pose();
+                let err = est.inverse() * pair.t_a_b;
+                let ok = err.translation.vector.norm() <= 2.0 * map.resolution()
+                    && err.rotation.angle().abs() <= 1f64.to_radians();
+                let st = (
+                    out.report.inliers,
+                    out.report.matches,
+                    out.report.acceptance_index.unwrap_or(0.0),
+                    out.report.common_cells,
+                    out.report.wall_agreement.unwrap_or(0.0),
+                );
+                if ok {
+                    correct += 1;
+                    stats_ok.push(st);
+                    accepted_ok += gated as usize;
+                } else {
+                    stats_wrong.push(st);
+                    accepted_wrong += gated as usize;
+                }
+            }
+            let worst_wrong = stats_wrong
+                .iter()
+                .map(|s| (s.0, s.0 as f64 / (8.0 + 0.3 * s.1 as f64), s.2, s.3, s.4))
+                .fold((0, 0.0f64, 0.0f64, 0, 0.0f64), |m, s| {
+                    (m.0.max(s.0), m.1.max(s.1), m.2.max(s.2), m.3.max(s.3), m.4.max(s.4))
+                });
+            let weakest_ok = stats_ok
+                .iter()
+                .map(|s| (s.0, s.0 as f64 / (8.0 + 0.3 * s.1 as f64), s.2, s.3, s.4))
+                .fold((usize::MAX, f64::MAX, f64::MAX, usize::MAX, f64::MAX), |m, s| {
+                    (m.0.min(s.0), m.1.min(s.1), m.2.min(s.2), m.3.min(s.3), m.4.min(s.4))
+                });
+            println!(
+                "{name:5} overlap {overlap:5.2}: raw correct {correct}/{n}, accepted correct {accepted_ok}, accepted wrong {accepted_wrong}, mean {:.0} ms",
+                time / n as f64
+            );
+            println!(
+                "      wrong answers max (inliers, conf, omega, common, walls) = {worst_wrong:?}; correct min = {weakest_ok:?}"
+            );
+        }
+    }
+}

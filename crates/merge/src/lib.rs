@@ -1,0 +1,27 @@
+//! mrslam-merge: occupancy-grid map merging with unknown relative pose.
+//!
+//! The paper's SIFT merger ([`SiftMerger`], Algorithm 3) behind the [`Merger`] interface, a verification
+//! gate that rejects merges the maps themselves contradict ([`verify`]), fusion into one grid ([`fuse`]),
+//! and the generators evaluation needs: procedural floor plans ([`floorplan`]) and map pairs cut with a
+//! known overlap and a known transform ([`pairs`]).
+
+pub mod estimate;
+pub mod floorplan;
+pub mod fuse;
+pub mod map_image;
+pub mod matching;
+pub mod merger;
+pub mod pairs;
+pub mod report;
+pub mod resample;
+pub mod sift_merger;
+pub mod verify;
+
+pub use estimate::{Model, RansacParams};
+pub use fuse::FusionRule;
+pub use map_image::MapEncoding;
+pub use matching::MatchParams;
+pub use merger::{Alignment, Evidence, MergeOutcome, MergeParams, Merger, NoAlignment, merge};
+pub use report::{MergeReport, TransformXyt};
+pub use sift_merger::{SiftMerger, SiftMergerParams};
+pub use verify::VerifyParams;

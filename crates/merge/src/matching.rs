@@ -1,0 +1,120 @@
+//! Descriptor matching: nearest neighbour in descriptor space with Lowe's ratio test (paper Alg. 3, line 6).
+
+use mrslam_sift::{DESCRIPTOR_LEN, Features};
+use rayon::prelude::*;
+
+/// A correspondence between feature `a` of the first set and feature `b` of the second.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Match {
+    /// Index in the first feature set.
+    pub a: usize,
+    /// Index in the second feature set.
+    pub b: usize,
+    /// Euclidean descriptor distance.
+    pub distance: f32,
+}
+
+/// Matching parameters.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct MatchParams {
+    /// Lowe's ratio: keep a match when nearest < ratio × second nearest (Lowe 2004 uses 0.8; 0.75 here).
+    pub ratio: f32,
+    /// Keep only matches that are also the nearest neighbour in the other direction.
+    pub mutual: bool,
+    /// Spread the queries over threads.
+    pub parallel: bool,
+}
+
+impl Default for MatchParams {
+    fn default() -> Self {
+        MatchParams { ratio: 0.75, mutual: false, parallel: false }
+    }
+}
+
+#[inline]
+fn dist2(a: &[u8], b: &[u8]) -> u32 {
+    // Exact integer distance; the compiler vectorises this fixed-length loop.
+    let mut s = 0u32;
+    for k in 0..DESCRIPTOR_LEN {
+        let d = a[k] as i32 - b[k] as i32;
+        s += (d * d) as u32;
+    }
+    s
+}
+
+/// Nearest and second-nearest squared distances from `q` to the descriptors of `set`, with the nearest index.
+fn two_nearest(q: &[u8], set: &[u8]) -> (usize, u32, u32) {
+    let (mut bi, mut b1, mut b2) = (usize::MAX, u32::MAX, u32::MAX);
+    for (i, d) in set.chunks_exact(DESCRIPTOR_LEN).enumerate() {
+        let s = dist2(q, d);
+        if s < b1 {
+            b2 = b1;
+            b1 = s;
+            bi = i;
+        } else if s < b2 {
+            b2 = s;
+        }
+    }
+    (bi, b1, b2)
+}
+
+/// Matches every feature of `a` to its nearest neighbour in `b` that passes the ratio test.
+///
+/// Results are ordered by index in `a`, so they do not depend on thread scheduling.
+pub fn match_features(a: &Features, b: &Features, p: &MatchParams) -> Vec<Match> {
+    if a.is_empty() || b.len() < 2 {
+        return Vec::new();
+    }
+    let ratio2 = (p.ratio as f64).powi(2);
+    let query = |i: usize| -> Option<Match> {
+        let (j, d1, d2) = two_nearest(a.descriptor(i), &b.descriptors);
+        ((d1 as f64) < ratio2 * d2 as f64).then_some(Match { a: i, b: j, distance: (d1 as f32).sqrt() })
+    };
+    let mut matches: Vec<Match> = if p.parallel {
+        (0..a.len()).into_par_iter().filter_map(query).collect()
+    } else {
+        (0..a.len()).filter_map(query).collect()
+    };
+    if p.mutual {
+        matches.retain(|m| two_nearest(b.descriptor(m.b), &a.descriptors).0 == m.a);
+    }
+    matches
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use mrslam_sift::Keypoint;
+
+    fn features(descs: &[[u8; 4]]) -> Features {
+        let mut f = Features::default();
+        for d in descs {
+            f.keypoints.push(Keypoint { x: 0.0, y: 0.0, size: 1.0, angle: 0.0, response: 1.0, octave: 0 });
+            let mut full = [0u8; DESCRIPTOR_LEN];
+            full[..4].copy_from_slice(d);
+            f.descriptors.extend_from_slice(&full);
+        }
+        f
+    }
+
+    #[test]
+    fn ratio_test_drops_ambiguous_matches() {
+        let a = features(&[[10, 0, 0, 0], [0, 50, 0, 0]]);
+        let b = features(&[[0, 50, 1, 0], [11, 0, 0, 0], [0, 51, 0, 0]]);
+        let m = match_features(&a, &b, &MatchParams::default());
+        // a0 -> b1 clearly; a1 is equally near b0 and b2: ambiguous, dropped
+        assert_eq!(m.len(), 1);
+        assert_eq!((m[0].a, m[0].b), (0, 1));
+        assert!((m[0].distance - 1.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn mutual_check_and_parallel_agree() {
+        let a = features(&[[10, 0, 0, 0], [200, 0, 0, 0], [0, 90, 0, 0]]);
+        let b = features(&[[12, 0, 0, 0], [0, 90, 0, 0], [100, 100, 100, 100]]);
+        let serial = match_features(&a, &b, &MatchParams { ratio: 0.9, mutual: true, parallel: false });
+        let par = match_features(&a, &b, &MatchParams { ratio: 0.9, mutual: true, parallel: true });
+        assert_eq!(serial, par);
+        assert!(serial.iter().all(|m| (m.a, m.b) == (0, 0) || (m.a, m.b) == (2, 1)));
+    }
+}

@@ -1,0 +1,145 @@
+//! The merge pipeline shared by every algorithm: align, verify, fuse, report.
+
+use crate::fuse::{FusionRule, fuse};
+use crate::report::{MergeReport, TransformXyt};
+use crate::verify::{Agreement, VerifyParams, agreement, confidence, rejection_reason};
+use mrslam_core::{OccupancyGrid, Pose2};
+use nalgebra::Point2;
+use std::collections::BTreeMap;
+use std::time::Instant;
+
+/// What an algorithm found: the transform taking map b's frame into map a's, and its evidence.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Alignment {
+    /// Rigid transform `T_a_b` (points of b's frame into a's frame).
+    pub transform: Pose2,
+    /// Scale of the estimated model (1 for rigid).
+    pub scale: f64,
+    /// Tentative correspondences (feature matches, or candidate triangle pairs).
+    pub matches: usize,
+    /// Correspondences that support the transform.
+    pub inliers: usize,
+    /// Per-stage wall time, milliseconds.
+    pub timings_ms: BTreeMap<String, f64>,
+    /// Feature locations and inlier pairs, for drawing.
+    pub evidence: Evidence,
+}
+
+/// Where an algorithm's evidence lies, in each map's own frame.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Evidence {
+    /// Feature points of map a (map frame, metres).
+    pub points_a: Vec<Point2<f64>>,
+    /// Feature points of map b (map frame, metres).
+    pub points_b: Vec<Point2<f64>>,
+    /// Inlier pairs as (index in points_a, index in points_b).
+    pub inlier_pairs: Vec<(usize, usize)>,
+}
+
+/// Why an algorithm could not produce a transform, with the stage timings spent finding out.
+#[derive(Debug, Clone, PartialEq)]
+pub struct NoAlignment {
+    /// Human-readable reason.
+    pub reason: String,
+    /// Correspondences found before giving up.
+    pub matches: usize,
+    /// Per-stage wall time, milliseconds.
+    pub timings_ms: BTreeMap<String, f64>,
+    /// Evidence gathered before giving up.
+    pub evidence: Evidence,
+}
+
+/// A map-merging algorithm: finds the transform between two occupancy grids of unknown relative pose.
+pub trait Merger: Send + Sync {
+    /// Short name used in reports and on the command line (`sift`, `rmap`).
+    fn name(&self) -> &'static str;
+    /// Estimates `T_a_b`, or says why it cannot.
+    fn align(&self, a: &OccupancyGrid, b: &OccupancyGrid) -> Result<Alignment, Box<NoAlignment>>;
+}
+
+/// Parameters of the pipeline around an algorithm.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct MergeParams {
+    /// Thresholds of the verification gate.
+    pub verify: VerifyParams,
+    /// Apply the gate (false shows the raw algorithm's answer, accepted whatever it is).
+    pub verify_enabled: bool,
+    /// How aligned cells combine.
+    pub fusion: FusionRule,
+}
+
+impl Default for MergeParams {
+    fn default() -> Self {
+        MergeParams { verify: VerifyParams::default(), verify_enabled: true, fusion: FusionRule::LogOddsSum }
+    }
+}
+
+/// Everything a merge produced.
+#[derive(Debug, Clone)]
+pub struct MergeOutcome {
+    /// The report (also the JSON written by `--report`).
+    pub report: MergeReport,
+    /// The merged grid in a's frame, when accepted.
+    pub merged: Option<OccupancyGrid>,
+    /// The algorithm's evidence (present whether accepted or not).
+    pub evidence: Evidence,
+}
+
+fn ms(t: Instant) -> f64 {
+    t.elapsed().as_secs_f64() * 1e3
+}
+
+/// Runs an algorithm, verifies its answer against both maps, and fuses them when it passes.
+pub fn merge(merger: &dyn Merger, a: &OccupancyGrid, b: &OccupancyGrid, p: &MergeParams) -> MergeOutcome {
+    let start = Instant::now();
+    let alignment = match merger.align(a, b) {
+        Ok(al) => al,
+        Err(no) => {
+            let report = MergeReport {
+                accepted: false,
+                algorithm: merger.name().to_string(),
+                transform: None,
+                scale: None,
+                matches: no.matches,
+                inliers: 0,
+                confidence: 0.0,
+                acceptance_index: None,
+                common_cells: 0,
+                wall_agreement: None,
+                reason: Some(no.reason),
+                time_ms: ms(start),
+                timings_ms: no.timings_ms,
+            };
+            return MergeOutcome { report, merged: None, evidence: no.evidence };
+        }
+    };
+    let mut timings = alignment.timings_ms.clone();
+    let t = Instant::now();
+    let agr: Agreement = agreement(a, b, &alignment.transform);
+    timings.insert("verify".into(), ms(t));
+    let conf = confidence(alignment.inliers, alignment.matches);
+    let reason =
+        if p.verify_enabled { rejection_reason(&p.verify, alignment.inliers, alignment.matches, &agr) } else { None };
+    let merged = reason.is_none().then(|| {
+        let t = Instant::now();
+        let g = fuse(a, b, &alignment.transform, p.fusion);
+        timings.insert("fuse".into(), ms(t));
+        g
+    });
+    let report = MergeReport {
+        accepted: reason.is_none(),
+        algorithm: merger.name().to_string(),
+        transform: Some(TransformXyt::from_pose(&alignment.transform)),
+        scale: Some(alignment.scale),
+        matches: alignment.matches,
+        inliers: alignment.inliers,
+        confidence: conf,
+        acceptance_index: Some(agr.acceptance_index()),
+        common_cells: agr.common(),
+        wall_agreement: Some(agr.wall_agreement()),
+        reason,
+        time_ms: ms(start),
+        timings_ms: timings,
+    };
+    MergeOutcome { report, merged, evidence: alignment.evidence }
+}

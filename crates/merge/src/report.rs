@@ -1,0 +1,58 @@
+//! The merge report: what `--report` writes, as ../shared/DESIGN.md specifies it.
+
+use mrslam_core::{Pose2, pose, pose_xyt};
+use std::collections::BTreeMap;
+
+/// A planar transform as x, y (metres) and theta (radians).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct TransformXyt {
+    /// Translation along x, metres.
+    pub x: f64,
+    /// Translation along y, metres.
+    pub y: f64,
+    /// Rotation, radians.
+    pub theta: f64,
+}
+
+impl TransformXyt {
+    /// From a pose.
+    pub fn from_pose(p: &Pose2) -> Self {
+        let (x, y, theta) = pose_xyt(p);
+        TransformXyt { x, y, theta }
+    }
+    /// To a pose.
+    pub fn to_pose(&self) -> Pose2 {
+        pose(self.x, self.y, self.theta)
+    }
+}
+
+/// Result of one merge, accepted or not. `transform` maps points of b's frame into a's frame.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct MergeReport {
+    /// Whether the merge passed verification (and a merged map was produced).
+    pub accepted: bool,
+    /// Algorithm name.
+    pub algorithm: String,
+    /// Estimated `T_a_b`, when the algorithm produced one (also when rejected).
+    pub transform: Option<TransformXyt>,
+    /// Scale of the estimated model.
+    pub scale: Option<f64>,
+    /// Tentative correspondences.
+    pub matches: usize,
+    /// Supporting correspondences.
+    pub inliers: usize,
+    /// m-explore confidence inliers / (8 + 0.3 · matches).
+    pub confidence: f64,
+    /// Carpin's acceptance index of the aligned maps.
+    pub acceptance_index: Option<f64>,
+    /// Cells known in both aligned maps.
+    pub common_cells: usize,
+    /// Share of b's walls meeting a wall of a after alignment.
+    pub wall_agreement: Option<f64>,
+    /// Why the merge was rejected.
+    pub reason: Option<String>,
+    /// Wall time of the merge itself (file loading excluded), milliseconds.
+    pub time_ms: f64,
+    /// Per-stage wall time, milliseconds.
+    pub timings_ms: BTreeMap<String, f64>,
+}

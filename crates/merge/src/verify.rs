@@ -1,0 +1,172 @@
+//! Verification of a merge before it is trusted: inlier support and map agreement.
+//!
+//! Two independent checks. Feature support: the inlier count and m-explore's confidence
+//! `inliers / (8 + 0.3 · matches)`. Map consistency: Carpin's acceptance index
+//! ω = agree / (agree + disagree) over cells known in both aligned maps (Carpin, "Fast and accurate map
+//! merging for multi-robot systems", 2008), computed over enough common cells to mean something.
+
+use crate::resample::{GridGeometry, sample_cells};
+use mrslam_core::{CellState, OccupancyGrid, Pose2};
+
+/// Thresholds a merge must pass to be accepted.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct VerifyParams {
+    /// Fewest inlier matches.
+    pub min_inliers: usize,
+    /// Lowest m-explore confidence `inliers / (8 + 0.3 · matches)` (m-explore's default threshold is 1.0).
+    pub min_confidence: f64,
+    /// Lowest acceptance index over the common known cells.
+    pub min_acceptance: f64,
+    /// Fewest cells known in both maps for the acceptance index to count.
+    pub min_common_cells: usize,
+    /// Lowest share of b's walls meeting a's walls ([`Agreement::wall_agreement`]).
+    pub min_wall_agreement: f64,
+}
+
+impl Default for VerifyParams {
+    /// Chosen by measurement on generated pairs (BENCHMARKS.md, merge): no gap pair passes.
+    fn default() -> Self {
+        VerifyParams {
+            min_inliers: 4,
+            min_confidence: 0.2,
+            min_acceptance: 0.9,
+            min_common_cells: 200,
+            min_wall_agreement: 0.6,
+        }
+    }
+}
+
+/// Agreement of two aligned maps.
+#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize, serde::Deserialize)]
+pub struct Agreement {
+    /// Cells known in both maps with the same state.
+    pub agree: usize,
+    /// Cells known in both maps with opposite states (free in one, occupied in the other).
+    pub disagree: usize,
+    /// Occupied cells of b that land on known cells of a.
+    pub walls: usize,
+    /// Of those, the ones with an occupied cell of a within one cell (8-neighbourhood).
+    pub walls_matched: usize,
+}
+
+impl Agreement {
+    /// Carpin's acceptance index ω = agree / (agree + disagree); 0 when no cell is known in both.
+    pub fn acceptance_index(&self) -> f64 {
+        let n = self.agree + self.disagree;
+        if n == 0 { 0.0 } else { self.agree as f64 / n as f64 }
+    }
+
+    /// Cells known in both maps.
+    pub fn common(&self) -> usize {
+        self.agree + self.disagree
+    }
+
+    /// Share of b's walls over a's known cells that meet a wall of a within one cell; 0 when none.
+    ///
+    /// Free space dominates indoor maps, so a wrong alignment can still score a high acceptance index by
+    /// laying free on free; walls laid on walls are much rarer by chance.
+    pub fn wall_agreement(&self) -> f64 {
+        if self.walls == 0 { 0.0 } else { self.walls_matched as f64 / self.walls as f64 }
+    }
+}
+
+/// Compares map `a` with map `b` placed in a's frame by `t_a_b`, over the cells of `a`.
+pub fn agreement(a: &OccupancyGrid, b: &OccupancyGrid, t_a_b: &Pose2) -> Agreement {
+    let cells = a.cells();
+    let (w, h) = (a.width(), a.height());
+    let occupied = |i: usize| CellState::from_log_odds(cells[i]) == CellState::Occupied;
+    let mut r = Agreement::default();
+    sample_cells(&GridGeometry::of(a), b, t_a_b, |i, lb| {
+        let sa = CellState::from_log_odds(cells[i]);
+        let sb = CellState::from_log_odds(lb);
+        if sa == CellState::Unknown || sb == CellState::Unknown {
+            return;
+        }
+        if sa == sb {
+            r.agree += 1;
+        } else {
+            r.disagree += 1;
+        }
+        if sb == CellState::Occupied {
+            r.walls += 1;
+            let (x, y) = (i % w, i / w);
+            let near = (y.saturating_sub(1)..=(y + 1).min(h - 1))
+                .any(|yy| (x.saturating_sub(1)..=(x + 1).min(w - 1)).any(|xx| occupied(yy * w + xx)));
+            r.walls_matched += near as usize;
+        }
+    });
+    r
+}
+
+/// m-explore's match confidence.
+pub fn confidence(inliers: usize, matches: usize) -> f64 {
+    inliers as f64 / (8.0 + 0.3 * matches as f64)
+}
+
+/// Why a merge was rejected, or None when it passes every threshold.
+pub fn rejection_reason(p: &VerifyParams, inliers: usize, matches: usize, agreement: &Agreement) -> Option<String> {
+    let conf = confidence(inliers, matches);
+    if inliers < p.min_inliers {
+        Some(format!("only {inliers} inlier matches (need {})", p.min_inliers))
+    } else if conf < p.min_confidence {
+        Some(format!("confidence {conf:.2} below {:.2} ({inliers} inliers of {matches} matches)", p.min_confidence))
+    } else if agreement.common() < p.min_common_cells {
+        Some(format!("aligned maps share only {} known cells (need {})", agreement.common(), p.min_common_cells))
+    } else if agreement.wall_agreement() < p.min_wall_agreement {
+        Some(format!(
+            "only {:.0}% of b's walls over a's known cells meet a wall of a (need {:.0}%)",
+            100.0 * agreement.wall_agreement(),
+            100.0 * p.min_wall_agreement
+        ))
+    } else if agreement.acceptance_index() < p.min_acceptance {
+        Some(format!(
+            "acceptance index {:.3} below {:.3}: the aligned maps contradict each other",
+            agreement.acceptance_index(),
+            p.min_acceptance
+        ))
+    } else {
+        None
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use mrslam_core::pose;
+
+    #[test]
+    fn identical_maps_agree_fully_and_shifted_walls_disagree() {
+        let mut g = OccupancyGrid::new(20, 20, 0.1, pose(0.0, 0.0, 0.0)).unwrap();
+        for iy in 0..20 {
+            for ix in 0..20 {
+                g.set(ix, iy, if ix == 10 { 2.0 } else { -2.0 });
+            }
+        }
+        let same = agreement(&g, &g, &Pose2::identity());
+        assert_eq!((same.agree, same.disagree), (400, 0));
+        assert_eq!(same.acceptance_index(), 1.0);
+        assert_eq!(same.wall_agreement(), 1.0);
+        let shifted = agreement(&g, &g, &pose(0.3, 0.0, 0.0));
+        // the wall column and its image three cells over disagree in 2 columns of 20 cells
+        assert_eq!(shifted.disagree, 40);
+        assert!(shifted.acceptance_index() < 0.9);
+        assert_eq!(shifted.wall_agreement(), 0.0);
+        // one cell off still counts as meeting the wall
+        assert_eq!(agreement(&g, &g, &pose(0.1, 0.0, 0.0)).wall_agreement(), 1.0);
+    }
+
+    #[test]
+    fn reasons_name_the_failed_check() {
+        let p = VerifyParams::default();
+        let good = Agreement { agree: 1000, disagree: 10, walls: 100, walls_matched: 90 };
+        assert_eq!(rejection_reason(&p, 30, 40, &good), None);
+        assert!(rejection_reason(&p, 3, 40, &good).unwrap().contains("inlier"));
+        assert!(rejection_reason(&p, 9, 400, &good).unwrap().contains("confidence"));
+        let bad = Agreement { agree: 500, disagree: 500, ..good };
+        assert!(rejection_reason(&p, 30, 40, &bad).unwrap().contains("acceptance index"));
+        let astray = Agreement { walls_matched: 20, ..good };
+        assert!(rejection_reason(&p, 30, 40, &astray).unwrap().contains("walls"));
+        let tiny = Agreement { agree: 10, disagree: 0, ..good };
+        assert!(rejection_reason(&p, 30, 40, &tiny).unwrap().contains("share only"));
+    }
+}

@@ -1,0 +1,434 @@
+//! Scale-space extrema: 26-neighbour detection, sub-pixel/sub-scale refinement, contrast and edge tests.
+
+use crate::params::SiftParams;
+
+/// A pixel that is a strict-or-equal extremum among its 26 neighbours in a DoG layer.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Candidate {
+    /// Row in the octave image.
+    pub r: usize,
+    /// Column in the octave image.
+    pub c: usize,
+    /// DoG layer (1..=n_layers).
+    pub layer: usize,
+}
+
+/// A refined extremum (OpenCV `adjustLocalExtrema` output, octave-local).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Refined {
+    /// Integer row after refinement.
+    pub r: usize,
+    /// Integer column after refinement.
+    pub c: usize,
+    /// DoG layer after refinement.
+    pub layer: usize,
+    /// Sub-pixel column offset (|xc| < 0.5).
+    pub xc: f32,
+    /// Sub-pixel row offset.
+    pub xr: f32,
+    /// Sub-layer offset.
+    pub xi: f32,
+    /// Interpolated DoG value on the 0..1 scale.
+    pub contr: f32,
+}
+
+/// DoG values of one octave, formed on demand from its Gaussian layers: `D_l = G_{l+1} - G_l`.
+#[derive(Debug, Clone, Copy)]
+pub struct DogView<'a> {
+    /// The octave's Gaussian layers (each at least `w * h` long).
+    pub gauss: &'a [Vec<f32>],
+    /// Row length.
+    pub w: usize,
+}
+
+impl DogView<'_> {
+    /// DoG layer `l` at row `r`, column `c`.
+    #[inline(always)]
+    pub fn at(&self, l: usize, r: isize, c: isize) -> f32 {
+        let i = (r * self.w as isize + c) as usize;
+        self.gauss[l + 1][i] - self.gauss[l][i]
+    }
+}
+
+/// Columns tested together.
+const CHUNK: usize = 16;
+
+/// Reusable rolling rows (3 per DoG layer): DoG values and their 3-wide horizontal maxima and minima.
+#[derive(Debug, Default, Clone)]
+pub struct DogRows {
+    dog: Vec<f32>,
+    hmax: Vec<f32>,
+    hmin: Vec<f32>,
+}
+
+/// Appends to `out` the 26-neighbour extrema of DoG layers `1..=n_layers` (OpenCV's test: `|D| > threshold`
+/// and `D >= all neighbours` when positive, `<=` when negative), skipping `border` pixels at the edges.
+///
+/// DoG rows are formed once each into a small rolling buffer together with their 3-wide running max and
+/// min, so the 3x3x3 maximum (which may include the centre: `D >= max` is the same test) costs 9 loads per
+/// pixel. Chunks of pixels all below the threshold are skipped first; everything runs on whole chunks
+/// (vectorised), with AVX2 / AVX-512 copies picked at run time.
+///
+/// Only rows `rows` (clamped to `border .. h - border`) are scanned, so a caller can scan an octave in
+/// consecutive row ranges as its layers become available (Gaussian rows up to `rows.end` must be final);
+/// the ranges must start at `border` and follow each other (the rolling buffer carries over).
+#[allow(clippy::too_many_arguments)]
+pub fn find_candidates(
+    gauss: &[Vec<f32>],
+    w: usize,
+    h: usize,
+    n_layers: usize,
+    threshold: f32,
+    border: usize,
+    rows: std::ops::Range<usize>,
+    ring: &mut DogRows,
+    out: &mut Vec<Candidate>,
+) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        if std::arch::is_x86_feature_detected!("avx512f") {
+            // SAFETY: the CPU supports AVX-512F (checked just above).
+            unsafe { find_candidates_avx512(gauss, w, h, n_layers, threshold, border, rows, ring, out) };
+            return;
+        }
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU supports AVX2 (checked just above).
+            unsafe { find_candidates_avx2(gauss, w, h, n_layers, threshold, border, rows, ring, out) };
+            return;
+        }
+    }
+    find_candidates_impl(gauss, w, h, n_layers, threshold, border, rows, ring, out);
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+#[allow(clippy::too_many_arguments)]
+fn find_candidates_avx512(
+    gauss: &[Vec<f32>],
+    w: usize,
+    h: usize,
+    n_layers: usize,
+    threshold: f32,
+    border: usize,
+    rows: std::ops::Range<usize>,
+    ring: &mut DogRows,
+    out: &mut Vec<Candidate>,
+) {
+    find_candidates_impl(gauss, w, h, n_layers, threshold, border, rows, ring, out);
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[allow(clippy::too_many_arguments)]
+fn find_candidates_avx2(
+    gauss: &[Vec<f32>],
+    w: usize,
+    h: usize,
+    n_layers: usize,
+    threshold: f32,
+    border: usize,
+    rows: std::ops::Range<usize>,
+    ring: &mut DogRows,
+    out: &mut Vec<Candidate>,
+) {
+    find_candidates_impl(gauss, w, h, n_layers, threshold, border, rows, ring, out);
+}
+
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn find_candidates_impl(
+    gauss: &[Vec<f32>],
+    w: usize,
+    h: usize,
+    n_layers: usize,
+    threshold: f32,
+    border: usize,
+    rows: std::ops::Range<usize>,
+    ring: &mut DogRows,
+    out: &mut Vec<Candidate>,
+) {
+    if border == 0 || w < 2 * border + 1 || h < 2 * border + 1 {
+        return;
+    }
+    let n_dog = n_layers + 2;
+    let ring_len = n_dog * 3 * w;
+    for v in [&mut ring.dog, &mut ring.hmax, &mut ring.hmin] {
+        if v.len() < ring_len {
+            v.resize(ring_len, 0.0);
+        }
+    }
+    let (dog, hmax, hmin) = (&mut ring.dog[..ring_len], &mut ring.hmax[..ring_len], &mut ring.hmin[..ring_len]);
+    #[inline(always)]
+    fn fill_row(gauss: &[Vec<f32>], w: usize, n_dog: usize, rows: (&mut [f32], &mut [f32], &mut [f32]), y: usize) {
+        let (dog, hmax, hmin) = rows;
+        for l in 0..n_dog {
+            let slot = (l * 3 + y % 3) * w;
+            let d = &mut dog[slot..slot + w];
+            let (a, b) = (&gauss[l][y * w..y * w + w], &gauss[l + 1][y * w..y * w + w]);
+            for ((o, &x), &z) in d.iter_mut().zip(a).zip(b) {
+                *o = z - x;
+            }
+            let d: &[f32] = d;
+            let (mx, mn) = (&mut hmax[slot + 1..slot + w - 1], &mut hmin[slot + 1..slot + w - 1]);
+            for ((o, p), q) in mx.iter_mut().zip(mn.iter_mut()).zip(d.windows(3)) {
+                let m = if q[0] > q[1] { q[0] } else { q[1] };
+                *o = if q[2] > m { q[2] } else { m };
+                let m = if q[0] < q[1] { q[0] } else { q[1] };
+                *p = if q[2] < m { q[2] } else { m };
+            }
+        }
+    }
+    let (r_from, r_to) = (rows.start.max(border), rows.end.min(h - border));
+    if r_from >= r_to {
+        return;
+    }
+    if r_from == border {
+        fill_row(gauss, w, n_dog, (&mut *dog, &mut *hmax, &mut *hmin), border - 1);
+        fill_row(gauss, w, n_dog, (&mut *dog, &mut *hmax, &mut *hmin), border);
+    }
+    for r in r_from..r_to {
+        fill_row(gauss, w, n_dog, (&mut *dog, &mut *hmax, &mut *hmin), r + 1);
+        let (dog, hmax, hmin): (&[f32], &[f32], &[f32]) = (dog, hmax, hmin);
+        let row = |l: usize, y: usize| (l * 3 + y % 3) * w;
+        for layer in 1..=n_layers {
+            let cur = &dog[row(layer, r)..row(layer, r) + w];
+            let mut maxs: [&[f32]; 9] = [cur; 9];
+            let mut mins: [&[f32]; 9] = [cur; 9];
+            let mut k = 0;
+            for l in layer - 1..=layer + 1 {
+                for y in r - 1..=r + 1 {
+                    let o = row(l, y);
+                    maxs[k] = &hmax[o..o + w];
+                    mins[k] = &hmin[o..o + w];
+                    k += 1;
+                }
+            }
+            scan_row(cur, &maxs, &mins, w, border, threshold, |c| out.push(Candidate { r, c, layer }));
+        }
+    }
+}
+
+/// Tests columns `border .. w - border` of one DoG row: `maxs` / `mins` are the 3-wide running max / min
+/// of the 9 rows around it (3 layers x 3 rows).
+#[inline(always)]
+fn scan_row(
+    cur: &[f32],
+    maxs: &[&[f32]; 9],
+    mins: &[&[f32]; 9],
+    w: usize,
+    border: usize,
+    thr: f32,
+    mut push: impl FnMut(usize),
+) {
+    let end = w - border;
+    let mut c = border;
+    while c + CHUNK <= end {
+        let v: &[f32; CHUNK] = cur[c..c + CHUNK].try_into().expect("chunk");
+        let mut any = false;
+        for &x in v {
+            any |= x.abs() > thr;
+        }
+        if any {
+            let mut mx = [f32::MIN; CHUNK];
+            let mut mn = [f32::MAX; CHUNK];
+            for (a, b) in maxs.iter().zip(mins) {
+                let a: &[f32; CHUNK] = a[c..c + CHUNK].try_into().expect("chunk");
+                let b: &[f32; CHUNK] = b[c..c + CHUNK].try_into().expect("chunk");
+                for l in 0..CHUNK {
+                    mx[l] = if a[l] > mx[l] { a[l] } else { mx[l] };
+                    mn[l] = if b[l] < mn[l] { b[l] } else { mn[l] };
+                }
+            }
+            let mut hit = [false; CHUNK];
+            for l in 0..CHUNK {
+                let val = v[l];
+                hit[l] = (val.abs() > thr) & (((val > 0.0) & (val >= mx[l])) | ((val < 0.0) & (val <= mn[l])));
+            }
+            for (l, &h) in hit.iter().enumerate() {
+                if h {
+                    push(c + l);
+                }
+            }
+        }
+        c += CHUNK;
+    }
+    for c in c..end {
+        let val = cur[c];
+        if val.abs() <= thr {
+            continue;
+        }
+        let mx = maxs.iter().fold(f32::MIN, |m, r| m.max(r[c]));
+        let mn = mins.iter().fold(f32::MAX, |m, r| m.min(r[c]));
+        if (val > 0.0 && val >= mx) || (val < 0.0 && val <= mn) {
+            push(c);
+        }
+    }
+}
+
+#[allow(clippy::needless_range_loop)]
+/// Solves `h x = b` by LU with partial pivoting as OpenCV's `hal::LU32f`; `None` when singular.
+fn solve3(mut a: [[f32; 3]; 3], mut b: [f32; 3]) -> Option<[f32; 3]> {
+    for i in 0..3 {
+        let mut k = i;
+        for j in i + 1..3 {
+            if a[j][i].abs() > a[k][i].abs() {
+                k = j;
+            }
+        }
+        if a[k][i].abs() < f32::EPSILON {
+            return None;
+        }
+        if k != i {
+            a.swap(i, k);
+            b.swap(i, k);
+        }
+        let d = -1.0 / a[i][i];
+        for j in i + 1..3 {
+            let alpha = a[j][i] * d;
+            for c in i + 1..3 {
+                a[j][c] += alpha * a[i][c];
+            }
+            b[j] += alpha * b[i];
+        }
+        a[i][i] = -d;
+    }
+    for i in (0..3).rev() {
+        let mut s = b[i];
+        for k in i + 1..3 {
+            s -= a[i][k] * b[k];
+        }
+        b[i] = s * a[i][i];
+    }
+    Some(b)
+}
+
+/// Refines a candidate to sub-pixel and sub-scale accuracy (Lowe 2004 §4, OpenCV `adjustLocalExtrema`)
+/// and applies the contrast and edge tests. `None` when rejected.
+pub fn refine(dog: DogView<'_>, w: usize, h: usize, cand: Candidate, params: &SiftParams) -> Option<Refined> {
+    let img_scale = 1.0f32 / 255.0;
+    let deriv_scale = img_scale * 0.5;
+    let second_deriv_scale = img_scale;
+    let cross_deriv_scale = img_scale * 0.25;
+    let n_layers = params.n_octave_layers;
+    let border = params.border as isize;
+    let (mut r, mut c, mut layer) = (cand.r as isize, cand.c as isize, cand.layer as isize);
+    let (mut xi, mut xr, mut xc) = (0.0f32, 0.0f32, 0.0f32);
+    let wi = w as isize;
+    let mut converged = false;
+    for _ in 0..params.max_interp_steps {
+        let (img, prev, next) = (layer as usize, layer as usize - 1, layer as usize + 1);
+        let at = |l: usize, rr: isize, cc: isize| dog.at(l, rr, cc);
+        let d_d = [
+            (at(img, r, c + 1) - at(img, r, c - 1)) * deriv_scale,
+            (at(img, r + 1, c) - at(img, r - 1, c)) * deriv_scale,
+            (at(next, r, c) - at(prev, r, c)) * deriv_scale,
+        ];
+        let v2 = at(img, r, c) * 2.0;
+        let dxx = (at(img, r, c + 1) + at(img, r, c - 1) - v2) * second_deriv_scale;
+        let dyy = (at(img, r + 1, c) + at(img, r - 1, c) - v2) * second_deriv_scale;
+        let dss = (at(next, r, c) + at(prev, r, c) - v2) * second_deriv_scale;
+        let dxy = (at(img, r + 1, c + 1) - at(img, r + 1, c - 1) - at(img, r - 1, c + 1) + at(img, r - 1, c - 1))
+            * cross_deriv_scale;
+        let dxs =
+            (at(next, r, c + 1) - at(next, r, c - 1) - at(prev, r, c + 1) + at(prev, r, c - 1)) * cross_deriv_scale;
+        let dys =
+            (at(next, r + 1, c) - at(next, r - 1, c) - at(prev, r + 1, c) + at(prev, r - 1, c)) * cross_deriv_scale;
+        let x = solve3([[dxx, dxy, dxs], [dxy, dyy, dys], [dxs, dys, dss]], d_d).unwrap_or([0.0; 3]);
+        xi = -x[2];
+        xr = -x[1];
+        xc = -x[0];
+        if xi.abs() < 0.5 && xr.abs() < 0.5 && xc.abs() < 0.5 {
+            converged = true;
+            break;
+        }
+        let lim = (i32::MAX / 3) as f32;
+        if !(xi.abs() <= lim && xr.abs() <= lim && xc.abs() <= lim) {
+            return None;
+        }
+        c += xc.round_ties_even() as isize;
+        r += xr.round_ties_even() as isize;
+        layer += xi.round_ties_even() as isize;
+        if layer < 1
+            || layer > n_layers as isize
+            || c < border
+            || c >= wi - border
+            || r < border
+            || r >= h as isize - border
+        {
+            return None;
+        }
+    }
+    if !converged {
+        return None;
+    }
+    let (img, prev, next) = (layer as usize, layer as usize - 1, layer as usize + 1);
+    let at = |l: usize, rr: isize, cc: isize| dog.at(l, rr, cc);
+    let d_d = [
+        (at(img, r, c + 1) - at(img, r, c - 1)) * deriv_scale,
+        (at(img, r + 1, c) - at(img, r - 1, c)) * deriv_scale,
+        (at(next, r, c) - at(prev, r, c)) * deriv_scale,
+    ];
+    let t = d_d[0] * xc + d_d[1] * xr + d_d[2] * xi;
+    let contr = at(img, r, c) * img_scale + t * 0.5;
+    if contr.abs() * (n_layers as f32) < params.contrast_threshold {
+        return None;
+    }
+    let v2 = at(img, r, c) * 2.0;
+    let dxx = (at(img, r, c + 1) + at(img, r, c - 1) - v2) * second_deriv_scale;
+    let dyy = (at(img, r + 1, c) + at(img, r - 1, c) - v2) * second_deriv_scale;
+    let dxy = (at(img, r + 1, c + 1) - at(img, r + 1, c - 1) - at(img, r - 1, c + 1) + at(img, r - 1, c - 1))
+        * cross_deriv_scale;
+    let tr = dxx + dyy;
+    let det = dxx * dyy - dxy * dxy;
+    let et = params.edge_threshold;
+    if det <= 0.0 || tr * tr * et >= (et + 1.0) * (et + 1.0) * det {
+        return None;
+    }
+    Some(Refined { r: r as usize, c: c as usize, layer: layer as usize, xc, xr, xi, contr })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn solve3_solves() {
+        let a = [[4.0, 1.0, 0.5], [1.0, 3.0, 0.2], [0.5, 0.2, 2.0]];
+        let x = solve3(a, [1.0, 2.0, 3.0]).unwrap();
+        for (row, want) in a.iter().zip([1.0, 2.0, 3.0]) {
+            let got: f32 = row.iter().zip(&x).map(|(p, q)| p * q).sum();
+            assert!((got - want).abs() < 1e-5);
+        }
+        assert!(solve3([[0.0; 3]; 3], [1.0; 3]).is_none());
+    }
+
+    #[test]
+    fn isolated_peaks_are_candidates() {
+        // Gaussian layers whose DoG layer 1 has a maximum at (8, 8) and a minimum at (20, 30).
+        let (w, h) = (40, 32);
+        let mut g = vec![vec![0.0f32; w * h]; 4];
+        g[2][8 * w + 8] = 5.0;
+        g[2][8 * w + 9] = 2.0;
+        g[2][20 * w + 30] = -3.0;
+        g[2][20 * w + 31] = -3.0; // equal neighbour: still an extremum (>= test), both found
+        let mut out = Vec::new();
+        let mut ring = DogRows::default();
+        find_candidates(&g, w, h, 1, 1.0, 5, 0..h, &mut ring, &mut out);
+        let mut split = Vec::new();
+        find_candidates(&g, w, h, 1, 1.0, 5, 0..13, &mut ring, &mut split);
+        find_candidates(&g, w, h, 1, 1.0, 5, 13..h, &mut ring, &mut split);
+        assert_eq!(out, split);
+        out.sort_by_key(|c| (c.r, c.c));
+        assert_eq!(
+            out,
+            vec![
+                Candidate { r: 8, c: 8, layer: 1 },
+                Candidate { r: 20, c: 30, layer: 1 },
+                Candidate { r: 20, c: 31, layer: 1 }
+            ]
+        );
+        out.clear();
+        find_candidates(&g, 10, 10, 1, 1.0, 5, 0..10, &mut ring, &mut out);
+        assert!(out.is_empty());
+    }
+}

@@ -1,0 +1,182 @@
+//! `mrslam merge A.yaml B.yaml -o MERGED.yaml`: merge two maps of unknown relative pose.
+
+use anyhow::{Context, Result, bail};
+use clap::Args;
+use mrslam_core::OccupancyGrid;
+use mrslam_core::map_io::{self, write_file_atomic};
+use mrslam_merge::map_image::MapImage;
+use mrslam_merge::{
+    Evidence, FusionRule, MapEncoding, MatchParams, MergeParams, MergeReport, Merger, Model, SiftMerger,
+    SiftMergerParams, merge,
+};
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+/// Arguments of `mrslam merge`.
+#[derive(Args)]
+pub struct MergeArgs {
+    /// First map (map_server YAML); the merged map is in its frame.
+    pub a: PathBuf,
+    /// Second map (map_server YAML).
+    pub b: PathBuf,
+    /// Merged map to write (YAML + PGM beside it); not written when the merge is rejected.
+    #[arg(short, long)]
+    pub output: Option<PathBuf>,
+    /// Write the merge report (JSON) here, accepted or not.
+    #[arg(long)]
+    pub report: Option<PathBuf>,
+    /// Merge algorithm.
+    #[arg(long, default_value = "sift", value_parser = ["sift"])]
+    pub algorithm: String,
+    /// Transform model: rigid, similarity or homography (the paper's; its rigid part is used).
+    #[arg(long, default_value = "rigid")]
+    pub model: Model,
+    /// Lowe's ratio for descriptor matching.
+    #[arg(long, default_value_t = 0.75)]
+    pub ratio: f32,
+    /// Keep only mutual nearest-neighbour matches.
+    #[arg(long)]
+    pub mutual: bool,
+    /// Map-to-image encoding: `walls` (free and unknown alike) or `paper` (unknown grey).
+    #[arg(long, default_value = "walls", value_parser = ["walls", "paper"])]
+    pub encoding: String,
+    /// How aligned cells combine: log-odds-sum or occupied-free-unknown.
+    #[arg(long, default_value = "log-odds-sum")]
+    pub fusion: FusionRule,
+    /// Skip the verification gate and accept whatever the algorithm answers.
+    #[arg(long)]
+    pub no_verify: bool,
+    /// Seed of the robust estimator.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Draw both maps side by side with the inlier matches (PNG).
+    #[arg(long)]
+    pub matches_png: Option<PathBuf>,
+}
+
+/// Runs `mrslam merge`.
+pub fn run(args: MergeArgs) -> Result<ExitCode> {
+    let a = map_io::read_ros_map(&args.a)?;
+    let b = map_io::read_ros_map(&args.b)?;
+    let mut params = SiftMergerParams {
+        model: args.model,
+        matching: MatchParams { ratio: args.ratio, mutual: args.mutual, parallel: true },
+        encoding: if args.encoding == "paper" { MapEncoding::PAPER } else { MapEncoding::WALLS },
+        ..Default::default()
+    };
+    params.ransac.seed = args.seed;
+    let merger: Box<dyn Merger> = match args.algorithm.as_str() {
+        "sift" => Box::new(SiftMerger::new(params)),
+        other => bail!("unknown algorithm `{other}`"),
+    };
+    let mp = MergeParams { verify_enabled: !args.no_verify, fusion: args.fusion, ..MergeParams::default() };
+    let out = merge(merger.as_ref(), &a, &b, &mp);
+    if let Some(p) = &args.report {
+        let json = serde_json::to_vec_pretty(&out.report).context("serialising the report")?;
+        write_file_atomic(p, &json)?;
+    }
+    if let Some(p) = &args.matches_png {
+        draw_matches(&a, &b, &out.evidence, p)?;
+    }
+    print!("{}", summary(&out.report));
+    match (&out.merged, &args.output) {
+        (Some(g), Some(path)) => {
+            map_io::write_ros_map(g, path)?;
+            println!("merged map: {} ({}x{} cells)", path.display(), g.width(), g.height());
+        }
+        (None, Some(path)) => println!("merged map: not written to {} (merge rejected)", path.display()),
+        _ => {}
+    }
+    Ok(if out.report.accepted { ExitCode::SUCCESS } else { ExitCode::from(2) })
+}
+
+/// The human summary of a merge.
+pub fn summary(r: &MergeReport) -> String {
+    let mut s = format!(
+        "merge ({}): {}\n",
+        r.algorithm,
+        if r.accepted { "ACCEPTED".to_string() } else { "REJECTED".to_string() }
+    );
+    if let Some(reason) = &r.reason {
+        s += &format!("  reason:      {reason}\n");
+    }
+    if let Some(t) = &r.transform {
+        s += &format!(
+            "  transform:   x {:.3} m, y {:.3} m, theta {:.4} rad ({:.2} deg), scale {:.4}\n",
+            t.x,
+            t.y,
+            t.theta,
+            t.theta.to_degrees(),
+            r.scale.unwrap_or(1.0)
+        );
+    }
+    s += &format!(
+        "  evidence:    {} inliers of {} matches, confidence {:.2}, acceptance index {}, {} common cells\n",
+        r.inliers,
+        r.matches,
+        r.confidence,
+        r.acceptance_index.map_or("-".to_string(), |v| format!("{v:.3}")),
+        r.common_cells
+    );
+    let stages: Vec<String> = r.timings_ms.iter().map(|(k, v)| format!("{k} {v:.1}")).collect();
+    s += &format!("  time:        {:.1} ms ({})\n", r.time_ms, stages.join(", "));
+    s
+}
+
+/// Draws both maps side by side (a left, b right), every feature as a dot and the inliers as lines.
+fn draw_matches(a: &OccupancyGrid, b: &OccupancyGrid, ev: &Evidence, path: &Path) -> Result<()> {
+    let enc = MapEncoding::PAPER;
+    let (ia, ib) = (MapImage::render(a, &enc, 8), MapImage::render(b, &enc, 8));
+    let (w, h) = (ia.width + ib.width, ia.height.max(ib.height));
+    if w == 0 || h == 0 {
+        bail!("{}: nothing to draw, both maps are empty", path.display());
+    }
+    let mut img = image::RgbImage::from_pixel(w as u32, h as u32, image::Rgb([205, 205, 205]));
+    for (im, dx) in [(&ia, 0usize), (&ib, ia.width)] {
+        for v in 0..im.height {
+            for u in 0..im.width {
+                let g = im.pixels[v * im.width + u] as u8;
+                img.put_pixel((u + dx) as u32, v as u32, image::Rgb([g, g, g]));
+            }
+        }
+    }
+    let to_px = |im: &MapImage, g: &OccupancyGrid, p: &nalgebra::Point2<f64>, dx: usize| {
+        let (u, v) = im.map_to_pixel(g, p);
+        (u + dx as f64, v)
+    };
+    let mut dot = |x: f64, y: f64, c: [u8; 3]| {
+        for oy in -1..=1 {
+            for ox in -1..=1 {
+                let (px, py) = (x.round() as i64 + ox, y.round() as i64 + oy);
+                if px >= 0 && py >= 0 && (px as usize) < w && (py as usize) < h {
+                    img.put_pixel(px as u32, py as u32, image::Rgb(c));
+                }
+            }
+        }
+    };
+    for p in &ev.points_a {
+        let (x, y) = to_px(&ia, a, p, 0);
+        dot(x, y, [40, 90, 220]);
+    }
+    for p in &ev.points_b {
+        let (x, y) = to_px(&ib, b, p, ia.width);
+        dot(x, y, [40, 90, 220]);
+    }
+    for &(i, j) in &ev.inlier_pairs {
+        let (x0, y0) = to_px(&ia, a, &ev.points_a[i], 0);
+        let (x1, y1) = to_px(&ib, b, &ev.points_b[j], ia.width);
+        let n = (x1 - x0).abs().max((y1 - y0).abs()).ceil().max(1.0) as usize;
+        for k in 0..=n {
+            let t = k as f64 / n as f64;
+            let (x, y) = (x0 + t * (x1 - x0), y0 + t * (y1 - y0));
+            if x >= 0.0 && y >= 0.0 && (x as usize) < w && (y as usize) < h {
+                img.put_pixel(x as u32, y as u32, image::Rgb([20, 170, 60]));
+            }
+        }
+    }
+    let mut bytes = Vec::new();
+    img.write_to(&mut std::io::Cursor::new(&mut bytes), image::ImageFormat::Png)
+        .with_context(|| format!("{}: encoding PNG", path.display()))?;
+    write_file_atomic(path, &bytes)?;
+    Ok(())
+}
