@@ -26,6 +26,8 @@ enum Command {
     /// Inspect CARMEN laser logs.
     #[command(subcommand)]
     Log(cmd::log::LogCommand),
+    /// Map a CARMEN log with GMapping-style particle filter SLAM.
+    Slam(cmd::slam::SlamArgs),
 }
 
 fn main() -> ExitCode {
@@ -34,6 +36,7 @@ fn main() -> ExitCode {
         Command::Map(c) => cmd::map::run(c),
         Command::Log(c) => cmd::log::run(c),
         Command::Merge(a) => cmd::merge::run(a),
+        Command::Slam(a) => cmd::slam::run(a),
     };
     match result {
         Ok(code) => code,

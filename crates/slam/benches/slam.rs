@@ -1,0 +1,67 @@
+//! Criterion benchmarks: one filter update (30 particles, 667-beam Hokuyo scan), and the memory of 30
+//! particles after mapping a 50 m corridor (printed, not timed).
+
+use criterion::{BatchSize, Criterion, criterion_group, criterion_main};
+use mrslam_core::pose;
+use mrslam_slam::synthetic::{self, Drift, Lidar};
+use mrslam_slam::{Rbpf, SlamParams};
+
+fn drift() -> Drift {
+    Drift { scale: 0.03, heading_per_m: 0.01, sigma_trans: 0.02, sigma_rot: 0.01 }
+}
+
+fn corridor_filter() -> (Rbpf, synthetic::SyntheticRun, usize) {
+    let map = synthetic::corridor_map(52.0);
+    let path = synthetic::waypoint_path(&[(1.0, 2.5), (51.0, 2.5)], 0.05, 0.1);
+    let run = synthetic::simulate(&map, &path, 0.1, &Lidar::hokuyo(), pose(0.1, 0.0, 0.0), &drift(), 1);
+    let mut f = Rbpf::new(SlamParams::hokuyo(), run.laser_offset, 1).expect("valid params");
+    // Map the first 20 m; the benchmark then processes one more scan, 0.25 m further on.
+    let stop = 400;
+    for k in 0..stop {
+        f.process(&run.odometry[k], &run.scans[k]).expect("synthetic input is valid");
+    }
+    (f, run, stop)
+}
+
+fn update(c: &mut Criterion) {
+    let (f, run, stop) = corridor_filter();
+    let k = stop + 5;
+    c.bench_function("rbpf_update_30p_667beams", |b| {
+        b.iter_batched(
+            || f.clone(),
+            |mut f| {
+                let out = f.process(&run.odometry[k], &run.scans[k]).expect("valid");
+                assert!(out.is_processed());
+                f
+            },
+            BatchSize::SmallInput,
+        )
+    });
+}
+
+fn memory(_c: &mut Criterion) {
+    let map = synthetic::corridor_map(52.0);
+    let path = synthetic::waypoint_path(&[(1.0, 2.5), (51.0, 2.5)], 0.05, 0.1);
+    let run = synthetic::simulate(&map, &path, 0.1, &Lidar::hokuyo(), pose(0.1, 0.0, 0.0), &drift(), 1);
+    let mut f = Rbpf::new(SlamParams::hokuyo(), run.laser_offset, 1).expect("valid params");
+    for (o, s) in run.odometry.iter().zip(&run.scans) {
+        f.process(o, s).expect("valid");
+    }
+    let m = f.memory_stats();
+    println!(
+        "memory after a 50 m corridor, 30 particles: {} distinct tiles ({:.1} MB) vs {} referenced ({:.1} MB unshared); \
+         tile slots {:.2} MB; {} trajectory nodes ({:.2} MB incl. scans); total {:.1} MB; {} resamples",
+        m.unique_tiles,
+        m.tile_bytes as f64 / 1e6,
+        m.referenced_tiles,
+        m.unshared_tile_bytes() as f64 / 1e6,
+        m.slot_bytes as f64 / 1e6,
+        m.trajectory_nodes,
+        m.trajectory_bytes as f64 / 1e6,
+        m.total_bytes() as f64 / 1e6,
+        f.counters().resamples
+    );
+}
+
+criterion_group!(benches, update, memory);
+criterion_main!(benches);

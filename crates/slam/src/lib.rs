@@ -1,0 +1,29 @@
+//! mrslam-slam: a Rao-Blackwellised particle filter grid SLAM of GMapping's class.
+//!
+//! Grisetti, Stachniss and Burgard (2007), "Improved techniques for grid mapping with Rao-Blackwellized
+//! particle filters", as OpenSLAM's GMapping implements it: each particle carries a pose, a log weight, its
+//! own grid map and its trajectory; the proposal is the odometry motion model refined by a hill-climbing scan
+//! matcher on the particle's own map; weights are the scan likelihood at the matched pose; particles are
+//! resampled (systematic) when the effective sample size drops below a threshold.
+//!
+//! Data flow per [`Rbpf::process`] call: odometry increment → [`motion`] sampling for every particle →
+//! (when the robot moved enough) [`scan_matcher`] refinement and likelihood → [`resample`] → the scan's hits
+//! go into each particle's copy-on-write [`tile_map`] → a new [`particle`] trajectory node.
+//! The output map ([`Rbpf::map`]) is rebuilt by [`map_build`] from the best particle's trajectory.
+//!
+//! Units are SI; poses are `nalgebra::Isometry2<f64>`; the map frame is the first processed robot pose.
+
+pub mod error;
+pub mod map_build;
+pub mod motion;
+pub mod params;
+pub mod particle;
+pub mod rbpf;
+pub mod resample;
+pub mod scan_matcher;
+pub mod synthetic;
+pub mod tile_map;
+
+pub use error::SlamError;
+pub use params::SlamParams;
+pub use rbpf::{MemoryStats, Rbpf, SkipReason, UpdateOutcome, UpdateStats};

@@ -1,0 +1,108 @@
+//! The output map: the best particle's scans traced along its trajectory into a core [`OccupancyGrid`].
+//!
+//! Per cell GMapping's `PointAccumulator` counts: `visits` (beams that crossed or ended in the cell) and
+//! `hits` (beams that ended in it). As GMapping's ROS node publishes it, a visited cell is occupied when
+//! hits/visits > `occ_thresh` and free otherwise; unvisited cells are unknown. The grid holds log-odds
+//! ±[`ROS_LOGODDS_LIMIT`] (p ≈ 0.88 / 0.12, beyond core's 0.65 / 0.35 thresholds) and 0 for unknown, so
+//! it reads back from map_server files unchanged.
+
+use crate::params::SlamParams;
+use crate::particle::TrajectoryNode;
+use crate::scan_matcher::Xyt;
+use mrslam_core::grid::MAX_CELLS;
+use mrslam_core::map_io::ROS_LOGODDS_LIMIT;
+use mrslam_core::{CellTraversal, LaserScan, OccupancyGrid, pose};
+
+/// Where a beam ends for mapping, and whether that end is a hit.
+fn beam_end(scan: &LaserScan, i: usize, params: &SlamParams) -> Option<(f64, bool)> {
+    let r = scan.ranges[i] as f64;
+    let max_range = params.max_range.min(scan.range_max as f64);
+    if scan.is_valid(i) && r < max_range {
+        Some((r.min(params.max_urange), r < params.max_urange))
+    } else if params.clear_max_range && (scan.is_max_range(i) || (scan.is_valid(i) && r >= max_range)) {
+        Some((params.max_urange.min(max_range), false))
+    } else {
+        None
+    }
+}
+
+/// Sensor pose (x, y, θ) for a robot pose.
+fn sensor(p: &Xyt, laser: &Xyt) -> Xyt {
+    let (s, c) = p.t.sin_cos();
+    Xyt { x: p.x + c * laser.x - s * laser.y, y: p.y + s * laser.x + c * laser.y, t: p.t + laser.t }
+}
+
+/// Builds the map of a trajectory (nodes in any order; order does not change the counts).
+///
+/// Returns a 1×1 unknown grid when there is nothing to map, and `None` when the map would exceed
+/// core's cell limit.
+pub fn build_map(nodes: &[&TrajectoryNode], laser: &Xyt, params: &SlamParams) -> Option<OccupancyGrid> {
+    let inv = 1.0 / params.delta;
+    // Pass 1: bounds in cells.
+    let (mut x0, mut y0, mut x1, mut y1) = (i64::MAX, i64::MAX, i64::MIN, i64::MIN);
+    let mut grow = |x: f64, y: f64| {
+        let (cx, cy) = ((x * inv).floor() as i64, (y * inv).floor() as i64);
+        x0 = x0.min(cx);
+        y0 = y0.min(cy);
+        x1 = x1.max(cx);
+        y1 = y1.max(cy);
+    };
+    for n in nodes {
+        let lp = sensor(&n.pose, laser);
+        grow(lp.x, lp.y);
+        for i in 0..n.scan.len() {
+            if let Some((r, _)) = beam_end(&n.scan, i, params) {
+                let a = lp.t + n.scan.angle(i);
+                grow(lp.x + r * a.cos(), lp.y + r * a.sin());
+            }
+        }
+    }
+    if x0 > x1 {
+        return OccupancyGrid::new(1, 1, params.delta, pose(0.0, 0.0, 0.0)).ok();
+    }
+    let (w, h) = ((x1 - x0 + 1) as usize, (y1 - y0 + 1) as usize);
+    if w.checked_mul(h).is_none_or(|c| c > MAX_CELLS) {
+        return None;
+    }
+    let mut hits = vec![0u32; w * h];
+    let mut visits = vec![0u32; w * h];
+    // Pass 2: trace.
+    for n in nodes {
+        let lp = sensor(&n.pose, laser);
+        let (sx, sy) = (lp.x * inv - x0 as f64, lp.y * inv - y0 as f64);
+        for i in 0..n.scan.len() {
+            let Some((r, hit)) = beam_end(&n.scan, i, params) else {
+                continue;
+            };
+            let a = lp.t + n.scan.angle(i);
+            let (ex, ey) = (sx + r * a.cos() * inv, sy + r * a.sin() * inv);
+            let trav = CellTraversal::new(sx, sy, ex, ey);
+            let end = trav.end_cell();
+            for (cx, cy) in trav {
+                if cx < 0 || cy < 0 || cx as usize >= w || cy as usize >= h {
+                    continue;
+                }
+                let k = cy as usize * w + cx as usize;
+                visits[k] = visits[k].saturating_add(1);
+                if hit && (cx, cy) == end {
+                    hits[k] = hits[k].saturating_add(1);
+                }
+            }
+        }
+    }
+    let cells: Vec<f32> = hits
+        .iter()
+        .zip(&visits)
+        .map(|(&hi, &v)| {
+            if v == 0 {
+                0.0
+            } else if hi as f64 > params.occ_thresh * v as f64 {
+                ROS_LOGODDS_LIMIT
+            } else {
+                -ROS_LOGODDS_LIMIT
+            }
+        })
+        .collect();
+    let origin = pose(x0 as f64 * params.delta, y0 as f64 * params.delta, 0.0);
+    OccupancyGrid::from_cells(w, h, params.delta, origin, cells).ok()
+}

@@ -1,0 +1,466 @@
+//! The filter: GMapping's `GridSlamProcessor::processScan` loop over odometry + scans.
+
+use crate::error::SlamError;
+use crate::map_build::build_map;
+use crate::motion::MotionModel;
+use crate::params::SlamParams;
+use crate::particle::{Particle, TrajectoryNode, ancestry};
+use crate::resample::{normalize, systematic};
+use crate::scan_matcher::{PreparedScan, ScanMatcher, Xyt};
+use mrslam_core::pose::{pose_xyt, relative};
+use mrslam_core::{LaserScan, OccupancyGrid, Odometry, Pose2, pose};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use std::sync::Arc;
+
+/// Odometry farther than this from its frame's origin (metres) is refused as corrupt.
+const MAX_ODOM_COORD: f64 = 1e6;
+/// Most beams accepted in one scan.
+const MAX_BEAMS: usize = 100_000;
+
+/// Why a scan was not processed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SkipReason {
+    /// The robot has not moved (or waited) enough since the last processed scan; its odometry still moved
+    /// the particles.
+    NotMoved,
+    /// The scan has no beams; its odometry still moved the particles.
+    EmptyScan,
+}
+
+/// Statistics of one processed scan.
+#[derive(Debug, Clone, PartialEq)]
+pub struct UpdateStats {
+    /// Neff of the weights computed at this update (the value the resampling decision was made on).
+    pub neff: f64,
+    /// Whether the particles were resampled.
+    pub resampled: bool,
+    /// Particles whose scan-matched pose replaced the motion-model pose (score > minimum_score).
+    pub matched_particles: usize,
+    /// Mean matcher score over particles.
+    pub mean_score: f64,
+    /// Beams the matcher used.
+    pub beams_matched: usize,
+    /// Beams recorded as hits.
+    pub beams_mapped: usize,
+    /// Beams ignored as invalid (NaN, negative, below the sensor's minimum range).
+    pub invalid_beams: usize,
+    /// Index of the best particle after the update.
+    pub best: usize,
+}
+
+/// What [`Rbpf::process`] did with a reading.
+#[derive(Debug, Clone, PartialEq)]
+pub enum UpdateOutcome {
+    /// The scan was matched and mapped.
+    Processed(UpdateStats),
+    /// The scan was not processed (odometry still applied).
+    Skipped(SkipReason),
+}
+
+impl UpdateOutcome {
+    /// True when the scan was processed.
+    pub fn is_processed(&self) -> bool {
+        matches!(self, UpdateOutcome::Processed(_))
+    }
+    /// Neff of the update, when processed.
+    pub fn neff(&self) -> Option<f64> {
+        match self {
+            UpdateOutcome::Processed(s) => Some(s.neff),
+            UpdateOutcome::Skipped(_) => None,
+        }
+    }
+    /// True when the update resampled.
+    pub fn resampled(&self) -> bool {
+        matches!(self, UpdateOutcome::Processed(s) if s.resampled)
+    }
+}
+
+/// Running totals over all readings.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Counters {
+    /// Readings given to [`Rbpf::process`] and accepted.
+    pub readings: usize,
+    /// Scans processed.
+    pub processed: usize,
+    /// Scans skipped because the robot had not moved enough.
+    pub skipped_not_moved: usize,
+    /// Scans skipped because they had no beams.
+    pub skipped_empty: usize,
+    /// Beams ignored as invalid (NaN, negative, below range_min), over all readings.
+    pub invalid_beams: usize,
+    /// Resampling steps.
+    pub resamples: usize,
+}
+
+/// Memory held by the particles' maps and trajectories.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct MemoryStats {
+    /// Number of particles.
+    pub particles: usize,
+    /// Distinct tiles across all particles (what is really allocated).
+    pub unique_tiles: usize,
+    /// Tiles referenced, summed over particles (what N unshared maps would hold).
+    pub referenced_tiles: usize,
+    /// Bytes of the distinct tiles.
+    pub tile_bytes: usize,
+    /// Bytes of the particles' tile-pointer arrays.
+    pub slot_bytes: usize,
+    /// Distinct trajectory nodes.
+    pub trajectory_nodes: usize,
+    /// Bytes of the distinct trajectory nodes and their scans.
+    pub trajectory_bytes: usize,
+}
+
+impl MemoryStats {
+    /// All bytes counted.
+    pub fn total_bytes(&self) -> usize {
+        self.tile_bytes + self.slot_bytes + self.trajectory_bytes
+    }
+    /// Bytes the maps would take without sharing.
+    pub fn unshared_tile_bytes(&self) -> usize {
+        self.referenced_tiles * crate::tile_map::Tile::BYTES
+    }
+}
+
+/// A Rao-Blackwellised particle filter SLAM (GMapping's algorithm).
+#[derive(Debug, Clone)]
+pub struct Rbpf {
+    params: SlamParams,
+    laser: Xyt,
+    matcher: ScanMatcher,
+    motion: MotionModel,
+    rng: ChaCha8Rng,
+    particles: Vec<Particle>,
+    weights: Vec<f64>,
+    neff: f64,
+    resampled_last: bool,
+    odo_pose: Option<Pose2>,
+    last_odom_stamp: Option<f64>,
+    last_scan_stamp: Option<f64>,
+    last_update_stamp: f64,
+    linear_distance: f64,
+    angular_distance: f64,
+    counters: Counters,
+}
+
+fn to_xyt(p: &Pose2) -> Xyt {
+    let (x, y, t) = pose_xyt(p);
+    Xyt { x, y, t }
+}
+
+fn to_pose(p: &Xyt) -> Pose2 {
+    pose(p.x, p.y, p.t)
+}
+
+impl Rbpf {
+    /// A filter with `params`, a laser mounted at `laser_offset` on the robot, and a seeded RNG.
+    pub fn new(params: SlamParams, laser_offset: Pose2, seed: u64) -> Result<Self, SlamError> {
+        params.validate().map_err(SlamError::BadParams)?;
+        let laser = to_xyt(&laser_offset);
+        if !(laser.x.is_finite() && laser.y.is_finite() && laser.t.is_finite()) {
+            return Err(SlamError::BadLaserOffset);
+        }
+        let matcher = ScanMatcher {
+            laser,
+            sigma: params.sigma,
+            lsigma: params.lsigma,
+            kernel_size: params.kernel_size,
+            lstep: params.lstep,
+            astep: params.astep,
+            iterations: params.iterations,
+        };
+        let motion = MotionModel { srr: params.srr, srt: params.srt, str: params.str, stt: params.stt };
+        let n = params.particles;
+        Ok(Rbpf {
+            particles: (0..n).map(|_| Particle::new(params.delta)).collect(),
+            weights: vec![1.0 / n as f64; n],
+            neff: n as f64,
+            params,
+            laser,
+            matcher,
+            motion,
+            rng: ChaCha8Rng::seed_from_u64(seed),
+            resampled_last: false,
+            odo_pose: None,
+            last_odom_stamp: None,
+            last_scan_stamp: None,
+            last_update_stamp: f64::NEG_INFINITY,
+            linear_distance: 0.0,
+            angular_distance: 0.0,
+            counters: Counters::default(),
+        })
+    }
+
+    /// The parameters in use.
+    pub fn params(&self) -> &SlamParams {
+        &self.params
+    }
+
+    /// Feeds one odometry reading and the scan taken with it.
+    ///
+    /// Every reading moves the particles by the odometry increment (motion model sampling). The scan is
+    /// processed (matched, weighted, maybe resampled, mapped) when it is the first, or the robot moved
+    /// `linear_update`/`angular_update` since the last processed scan, or `temporal_update` seconds passed.
+    ///
+    /// Errors (the filter's state is unchanged): non-finite odometry or scan geometry, stamps going
+    /// backwards, a map outgrowing its limit. Leniency (counted, not errors): NaN, negative or too-short
+    /// beams are ignored ([`Counters::invalid_beams`]); a scan with no beams is skipped.
+    pub fn process(&mut self, odom: &Odometry, scan: &LaserScan) -> Result<UpdateOutcome, SlamError> {
+        self.validate(odom, scan)?;
+        self.last_odom_stamp = Some(odom.stamp);
+        self.last_scan_stamp = Some(scan.stamp);
+        self.counters.readings += 1;
+
+        let Some(odo_pose) = self.odo_pose else {
+            if scan.is_empty() {
+                self.counters.skipped_empty += 1;
+                return Ok(UpdateOutcome::Skipped(SkipReason::EmptyScan));
+            }
+            // First scan: it defines the map frame; every particle maps it from the origin.
+            self.odo_pose = Some(odom.pose);
+            return self.update(odom, scan, true);
+        };
+
+        let (dx, dy, dt) = pose_xyt(&relative(&odo_pose, &odom.pose));
+        for p in &mut self.particles {
+            let moved = self.motion.draw_increment(&mut self.rng, &to_pose(&p.pose), dx, dy, dt);
+            p.pose = to_xyt(&moved);
+        }
+        self.linear_distance += dx.hypot(dy);
+        self.angular_distance += dt.abs();
+        self.odo_pose = Some(odom.pose);
+
+        if scan.is_empty() {
+            self.counters.skipped_empty += 1;
+            return Ok(UpdateOutcome::Skipped(SkipReason::EmptyScan));
+        }
+        let p = &self.params;
+        let due = self.linear_distance >= p.linear_update
+            || self.angular_distance >= p.angular_update
+            || (p.temporal_update >= 0.0 && scan.stamp - self.last_update_stamp > p.temporal_update);
+        if !due {
+            self.counters.skipped_not_moved += 1;
+            let prepared_invalid = (0..scan.len()).filter(|&i| !scan.is_valid(i) && !scan.is_max_range(i)).count();
+            self.counters.invalid_beams += prepared_invalid;
+            return Ok(UpdateOutcome::Skipped(SkipReason::NotMoved));
+        }
+        self.update(odom, scan, false)
+    }
+
+    /// Checks a reading before anything changes.
+    fn validate(&self, odom: &Odometry, scan: &LaserScan) -> Result<(), SlamError> {
+        let (x, y, t) = pose_xyt(&odom.pose);
+        let bad_odom = |message: String| SlamError::BadOdometry { stamp: odom.stamp, message };
+        if !odom.stamp.is_finite() {
+            return Err(bad_odom("stamp is not finite".into()));
+        }
+        if !(x.is_finite() && y.is_finite() && t.is_finite()) {
+            return Err(bad_odom(format!("pose ({x}, {y}, {t}) is not finite")));
+        }
+        if x.abs() > MAX_ODOM_COORD || y.abs() > MAX_ODOM_COORD {
+            return Err(bad_odom(format!("pose ({x}, {y}) is implausibly far from the origin")));
+        }
+        let bad_scan = |message: String| SlamError::BadScan { stamp: scan.stamp, message };
+        if !scan.stamp.is_finite() {
+            return Err(bad_scan("stamp is not finite".into()));
+        }
+        if !(scan.angle_min.is_finite() && scan.angle_increment.is_finite()) {
+            return Err(bad_scan("angle_min or angle_increment is not finite".into()));
+        }
+        if scan.range_min.is_nan() || scan.range_max.is_nan() || scan.range_max <= 0.0 {
+            return Err(bad_scan(format!("range limits [{}, {}] are not usable", scan.range_min, scan.range_max)));
+        }
+        if scan.len() > MAX_BEAMS {
+            return Err(bad_scan(format!("{} beams is more than {MAX_BEAMS}", scan.len())));
+        }
+        if let Some(prev) = self.last_odom_stamp
+            && odom.stamp < prev
+        {
+            return Err(SlamError::TimeWentBackwards { what: "odometry", previous: prev, got: odom.stamp });
+        }
+        if let Some(prev) = self.last_scan_stamp
+            && scan.stamp < prev
+        {
+            return Err(SlamError::TimeWentBackwards { what: "scan", previous: prev, got: scan.stamp });
+        }
+        Ok(())
+    }
+
+    /// Matches, weighs, resamples and maps one scan.
+    fn update(&mut self, _odom: &Odometry, scan: &LaserScan, first: bool) -> Result<UpdateOutcome, SlamError> {
+        let p = &self.params;
+        let prepared = PreparedScan::new(scan, p.max_range.min(scan.range_max as f64), p.max_urange, p.lskip);
+        self.counters.invalid_beams += prepared.invalid;
+        let n = self.particles.len();
+        let mut matched_particles = 0;
+        let mut score_sum = 0.0;
+        let mut resampled = false;
+        let mut neff = n as f64;
+        if !first {
+            let min_score = p.minimum_score;
+            for part in &mut self.particles {
+                let guarded = self.matcher.beams_in_map(&part.map, &part.pose, &prepared.matched);
+                let (corrected, score) = self.matcher.optimize(&part.map, &part.pose, &guarded);
+                if score > min_score {
+                    part.pose = corrected;
+                    matched_particles += 1;
+                }
+                score_sum += score;
+                let e = self.matcher.likelihood_and_score(&part.map, &part.pose, &prepared.matched);
+                part.weight += e.likelihood;
+                part.weight_sum += e.likelihood;
+            }
+            let gain = 1.0 / (self.params.ogain * n as f64);
+            let logw: Vec<f64> = self.particles.iter().map(|q| q.weight).collect();
+            let (w, ne) = normalize(&logw, gain);
+            neff = ne;
+            self.weights = w;
+            if neff < self.params.resample_threshold * n as f64 {
+                let u: f64 = self.rng.random();
+                let idx = systematic(&self.weights, n, u);
+                let mut next = Vec::with_capacity(n);
+                for &i in &idx {
+                    let mut q = self.particles[i].clone();
+                    q.weight = 0.0;
+                    next.push(q);
+                }
+                self.particles = next;
+                self.weights = vec![1.0 / n as f64; n];
+                resampled = true;
+                self.counters.resamples += 1;
+            }
+        }
+        self.neff = crate::resample::neff(&self.weights);
+        self.resampled_last = resampled;
+
+        // Map the scan in every particle and extend its trajectory.
+        let shared_scan = Arc::new(scan.clone());
+        for part in &mut self.particles {
+            let lp = self.matcher.laser_pose(&part.pose);
+            let (s, c) = lp.t.sin_cos();
+            for b in &prepared.hits {
+                let (dx, dy) = (c * b.c - s * b.s, s * b.c + c * b.s);
+                part.map.add_hit(lp.x + b.r * dx, lp.y + b.r * dy).map_err(|_| {
+                    SlamError::MapTooLarge(format!(
+                        "a particle at ({:.1}, {:.1}) m left the largest map supported",
+                        part.pose.x, part.pose.y
+                    ))
+                })?;
+            }
+            part.node = Some(Arc::new(TrajectoryNode {
+                stamp: scan.stamp,
+                pose: part.pose,
+                scan: shared_scan.clone(),
+                parent: part.node.take(),
+            }));
+        }
+        self.linear_distance = 0.0;
+        self.angular_distance = 0.0;
+        self.last_update_stamp = scan.stamp;
+        self.counters.processed += 1;
+        Ok(UpdateOutcome::Processed(UpdateStats {
+            neff,
+            resampled,
+            matched_particles,
+            mean_score: score_sum / n as f64,
+            beams_matched: prepared.matched.len(),
+            beams_mapped: prepared.hits.len(),
+            invalid_beams: prepared.invalid,
+            best: self.best_index(),
+        }))
+    }
+
+    /// Index of the best particle: the highest lineage log-likelihood (GMapping's `weightSum`), lowest index
+    /// on ties.
+    pub fn best_index(&self) -> usize {
+        let mut best = 0;
+        for (i, p) in self.particles.iter().enumerate() {
+            if p.weight_sum > self.particles[best].weight_sum {
+                best = i;
+            }
+        }
+        best
+    }
+
+    /// Current pose of the best particle (map frame), including motion since the last processed scan.
+    pub fn best_pose(&self) -> Pose2 {
+        to_pose(&self.particles[self.best_index()].pose)
+    }
+
+    /// The particles' current poses and normalised weights (for visualisation).
+    pub fn particles(&self) -> impl Iterator<Item = (Pose2, f64)> + '_ {
+        self.particles.iter().zip(&self.weights).map(|(p, &w)| (to_pose(&p.pose), w))
+    }
+
+    /// Effective sample size of the current normalised weights (N right after a resampling).
+    pub fn neff(&self) -> f64 {
+        self.neff
+    }
+
+    /// True when the last processed scan resampled the particles.
+    pub fn resampled_last_update(&self) -> bool {
+        self.resampled_last
+    }
+
+    /// Running totals.
+    pub fn counters(&self) -> Counters {
+        self.counters
+    }
+
+    /// The best particle's path: (stamp, robot pose in the map frame) per processed scan, oldest first.
+    pub fn trajectory(&self) -> Vec<(f64, Pose2)> {
+        let mut v: Vec<(f64, Pose2)> =
+            ancestry(&self.particles[self.best_index()].node).map(|n| (n.stamp, to_pose(&n.pose))).collect();
+        v.reverse();
+        v
+    }
+
+    /// The best particle's map as a log-odds grid (occupied +2, free −2, unknown 0; see [`crate::map_build`]).
+    ///
+    /// Rebuilt from the best particle's trajectory on every call (like GMapping's ROS node does every
+    /// `map_update_interval`): cost grows with the scans processed, so call it when a map is needed.
+    pub fn map(&self) -> Result<OccupancyGrid, SlamError> {
+        let nodes: Vec<&TrajectoryNode> = ancestry(&self.particles[self.best_index()].node).collect();
+        build_map(&nodes, &self.laser, &self.params)
+            .ok_or_else(|| SlamError::MapTooLarge("the trajectory's map exceeds core's grid size limit".into()))
+    }
+
+    /// Memory held by the particles' maps and trajectories, counting shared tiles and nodes once.
+    pub fn memory_stats(&self) -> MemoryStats {
+        let mut tiles: Vec<usize> = Vec::new();
+        let mut referenced = 0;
+        let mut slots = 0;
+        for p in &self.particles {
+            slots += p.map.tile_slots();
+            for t in p.map.tile_ptrs() {
+                tiles.push(t as usize);
+                referenced += 1;
+            }
+        }
+        tiles.sort_unstable();
+        tiles.dedup();
+        let mut nodes = std::collections::BTreeSet::new();
+        let mut scans = std::collections::BTreeSet::new();
+        let mut scan_bytes = 0;
+        for p in &self.particles {
+            for n in ancestry(&p.node) {
+                if !nodes.insert(n as *const TrajectoryNode as usize) {
+                    break;
+                }
+                if scans.insert(Arc::as_ptr(&n.scan) as usize) {
+                    scan_bytes += std::mem::size_of::<LaserScan>() + 4 * n.scan.ranges.capacity();
+                }
+            }
+        }
+        MemoryStats {
+            particles: self.particles.len(),
+            unique_tiles: tiles.len(),
+            referenced_tiles: referenced,
+            tile_bytes: tiles.len() * crate::tile_map::Tile::BYTES,
+            slot_bytes: slots * std::mem::size_of::<Option<Arc<crate::tile_map::Tile>>>(),
+            trajectory_nodes: nodes.len(),
+            trajectory_bytes: nodes.len() * std::mem::size_of::<TrajectoryNode>() + scan_bytes,
+        }
+    }
+}

@@ -1,0 +1,250 @@
+//! A particle's grid map: 32×32-cell tiles shared copy-on-write between particles.
+//!
+//! GMapping's `HierarchicalArray2D` of `PointAccumulator` patches, in Rust: the map is a growable 2D array of
+//! `Option<Arc<Tile>>`; cloning a map clones the array of pointers, not the cells; a write goes through
+//! [`Arc::make_mut`], which copies a tile only when another particle still shares it. So N particles cost one
+//! map plus the tiles each touched since their lineages split.
+//!
+//! Cell statistics (GMapping's `PointAccumulator`, as ROS `slam_gmapping` runs it with `generateMap` off):
+//! per cell the number of beam end points that fell in it (`hits`) and their mean position. The matcher's
+//! score needs exactly these: a cell is "occupied" when it has hits, "free" when it has none, and the
+//! distance is measured to the mean of the hits, which is sub-cell accurate. Misses (free space) are not
+//! traced per particle, which keeps an update cheap; the output map ([`crate::map_build`]) traces them
+//! along the best particle's trajectory.
+//!
+//! Cell `(ix, iy)` covers `[ix·delta, (ix+1)·delta) × [iy·delta, (iy+1)·delta)` of the map frame; indices may be
+//! negative.
+
+use std::sync::Arc;
+
+/// Log2 of the tile edge.
+pub const TILE_SHIFT: i32 = 5;
+/// Tile edge in cells (32).
+pub const TILE: i32 = 1 << TILE_SHIFT;
+const TILE_MASK: i32 = TILE - 1;
+const TILE_CELLS: usize = (TILE * TILE) as usize;
+/// Tiles added on each side when the tile array grows.
+const GROW_MARGIN: i32 = 4;
+/// Largest tile array accepted (tiles): 1024 × 1024 tiles, i.e. 1.6 km × 1.6 km at 5 cm.
+const MAX_TILE_SLOTS: usize = 1 << 20;
+/// Cell coordinates are clamped to ±this, far beyond any real map, so index arithmetic cannot overflow.
+const COORD_LIMIT: f64 = (1u32 << 28) as f64;
+
+/// One 32×32 patch of cells.
+#[derive(Clone)]
+pub struct Tile {
+    /// End points that fell in each cell, row-major (`ly * 32 + lx`).
+    pub hits: [u32; TILE_CELLS],
+    /// Mean end point of each cell, relative to the cell's lower corner, metres.
+    pub mean: [[f32; 2]; TILE_CELLS],
+}
+
+impl Tile {
+    /// Heap bytes of one tile.
+    pub const BYTES: usize = std::mem::size_of::<Tile>();
+
+    fn empty() -> Arc<Tile> {
+        Arc::new(Tile { hits: [0; TILE_CELLS], mean: [[0.0; 2]; TILE_CELLS] })
+    }
+}
+
+/// A grid of hit statistics made of copy-on-write tiles.
+#[derive(Clone)]
+pub struct TileMap {
+    delta: f64,
+    inv_delta: f64,
+    /// Tile coordinates of the array's first slot.
+    tx0: i32,
+    ty0: i32,
+    /// Array size in tiles.
+    tw: i32,
+    th: i32,
+    tiles: Vec<Option<Arc<Tile>>>,
+}
+
+impl std::fmt::Debug for TileMap {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("TileMap")
+            .field("delta", &self.delta)
+            .field("tiles", &(self.tx0, self.ty0, self.tw, self.th))
+            .field("allocated", &self.allocated_tiles())
+            .finish()
+    }
+}
+
+/// Error when a hit would grow the tile array past its limit.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct TooLarge;
+
+impl TileMap {
+    /// An empty map of `delta` metres per cell.
+    pub fn new(delta: f64) -> Self {
+        TileMap { delta, inv_delta: 1.0 / delta, tx0: 0, ty0: 0, tw: 0, th: 0, tiles: Vec::new() }
+    }
+
+    /// Metres per cell.
+    #[inline]
+    pub fn delta(&self) -> f64 {
+        self.delta
+    }
+
+    /// The cell a map-frame point falls in.
+    #[inline]
+    pub fn cell_of(&self, x: f64, y: f64) -> (i32, i32) {
+        let cx = (x * self.inv_delta).floor().clamp(-COORD_LIMIT, COORD_LIMIT);
+        let cy = (y * self.inv_delta).floor().clamp(-COORD_LIMIT, COORD_LIMIT);
+        (cx as i32, cy as i32)
+    }
+
+    /// The tile holding tile coordinates (tx, ty), if allocated.
+    #[inline]
+    pub fn tile(&self, tx: i32, ty: i32) -> Option<&Tile> {
+        let (x, y) = (tx.wrapping_sub(self.tx0), ty.wrapping_sub(self.ty0));
+        if x < 0 || y < 0 || x >= self.tw || y >= self.th {
+            return None;
+        }
+        self.tiles[(y * self.tw + x) as usize].as_deref()
+    }
+
+    /// Hits recorded in cell (ix, iy) (0 off the map).
+    #[inline]
+    pub fn hits(&self, ix: i32, iy: i32) -> u32 {
+        match self.tile(ix >> TILE_SHIFT, iy >> TILE_SHIFT) {
+            Some(t) => t.hits[local(ix, iy)],
+            None => 0,
+        }
+    }
+
+    /// Mean end point of cell (ix, iy) in the map frame (the cell's corner when it has no hits).
+    #[inline]
+    pub fn mean(&self, ix: i32, iy: i32) -> (f64, f64) {
+        let m = match self.tile(ix >> TILE_SHIFT, iy >> TILE_SHIFT) {
+            Some(t) => t.mean[local(ix, iy)],
+            None => [0.0, 0.0],
+        };
+        (ix as f64 * self.delta + m[0] as f64, iy as f64 * self.delta + m[1] as f64)
+    }
+
+    /// Records a beam end point at map-frame (x, y): one more hit for its cell, running mean updated.
+    pub fn add_hit(&mut self, x: f64, y: f64) -> Result<(), TooLarge> {
+        let (ix, iy) = self.cell_of(x, y);
+        let (tx, ty) = (ix >> TILE_SHIFT, iy >> TILE_SHIFT);
+        self.ensure(tx, ty)?;
+        let slot = ((ty - self.ty0) * self.tw + (tx - self.tx0)) as usize;
+        let tile = Arc::make_mut(self.tiles[slot].get_or_insert_with(Tile::empty));
+        let i = local(ix, iy);
+        let n = tile.hits[i].saturating_add(1);
+        tile.hits[i] = n;
+        let (ox, oy) = (x - ix as f64 * self.delta, y - iy as f64 * self.delta);
+        let m = &mut tile.mean[i];
+        let inv = 1.0 / n as f64;
+        m[0] += ((ox - m[0] as f64) * inv) as f32;
+        m[1] += ((oy - m[1] as f64) * inv) as f32;
+        Ok(())
+    }
+
+    /// Grows the tile array (by a margin) so that tile (tx, ty) has a slot.
+    fn ensure(&mut self, tx: i32, ty: i32) -> Result<(), TooLarge> {
+        let inside = tx >= self.tx0 && ty >= self.ty0 && tx < self.tx0 + self.tw && ty < self.ty0 + self.th;
+        if inside {
+            return Ok(());
+        }
+        let (nx0, ny0, nx1, ny1) = if self.tw == 0 {
+            (tx - GROW_MARGIN, ty - GROW_MARGIN, tx + GROW_MARGIN + 1, ty + GROW_MARGIN + 1)
+        } else {
+            (
+                if tx < self.tx0 { tx - GROW_MARGIN } else { self.tx0 },
+                if ty < self.ty0 { ty - GROW_MARGIN } else { self.ty0 },
+                if tx >= self.tx0 + self.tw { tx + GROW_MARGIN + 1 } else { self.tx0 + self.tw },
+                if ty >= self.ty0 + self.th { ty + GROW_MARGIN + 1 } else { self.ty0 + self.th },
+            )
+        };
+        let (nw, nh) = ((nx1 - nx0) as usize, (ny1 - ny0) as usize);
+        if nw.checked_mul(nh).is_none_or(|n| n > MAX_TILE_SLOTS) {
+            return Err(TooLarge);
+        }
+        let mut tiles = vec![None; nw * nh];
+        for y in 0..self.th {
+            for x in 0..self.tw {
+                let src = (y * self.tw + x) as usize;
+                let dst = (y + self.ty0 - ny0) as usize * nw + (x + self.tx0 - nx0) as usize;
+                tiles[dst] = self.tiles[src].take();
+            }
+        }
+        self.tiles = tiles;
+        self.tx0 = nx0;
+        self.ty0 = ny0;
+        self.tw = nw as i32;
+        self.th = nh as i32;
+        Ok(())
+    }
+
+    /// Number of tile slots (allocated or not).
+    pub fn tile_slots(&self) -> usize {
+        self.tiles.len()
+    }
+
+    /// Number of allocated tiles (shared or not).
+    pub fn allocated_tiles(&self) -> usize {
+        self.tiles.iter().filter(|t| t.is_some()).count()
+    }
+
+    /// Addresses of the allocated tiles, to count tiles shared between maps.
+    pub fn tile_ptrs(&self) -> impl Iterator<Item = *const Tile> + '_ {
+        self.tiles.iter().flatten().map(Arc::as_ptr)
+    }
+}
+
+/// Index of cell (ix, iy) inside its tile.
+#[inline]
+pub fn local(ix: i32, iy: i32) -> usize {
+    (((iy & TILE_MASK) << TILE_SHIFT) | (ix & TILE_MASK)) as usize
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn hits_and_means_round_trip_with_negative_cells() {
+        let mut m = TileMap::new(0.05);
+        m.add_hit(-1.012, 2.031).unwrap();
+        m.add_hit(-1.018, 2.039).unwrap();
+        let (ix, iy) = m.cell_of(-1.015, 2.035);
+        assert_eq!((ix, iy), (-21, 40));
+        assert_eq!(m.hits(ix, iy), 2);
+        let (mx, my) = m.mean(ix, iy);
+        assert!((mx + 1.015).abs() < 1e-6 && (my - 2.035).abs() < 1e-6, "{mx} {my}");
+        assert_eq!(m.hits(ix + 1, iy), 0);
+        assert_eq!(m.hits(10_000, -10_000), 0);
+        m.add_hit(50.0, -40.0).unwrap();
+        assert_eq!(m.hits(ix, iy), 2, "growth keeps old cells");
+        assert_eq!(m.allocated_tiles(), 2);
+    }
+
+    #[test]
+    fn clones_share_until_written() {
+        let mut a = TileMap::new(0.05);
+        a.add_hit(0.1, 0.1).unwrap();
+        a.add_hit(5.0, 0.1).unwrap();
+        let mut b = a.clone();
+        let shared = |a: &TileMap, b: &TileMap| {
+            let pa: Vec<_> = a.tile_ptrs().collect();
+            b.tile_ptrs().filter(|p| pa.contains(p)).count()
+        };
+        assert_eq!(shared(&a, &b), 2);
+        b.add_hit(0.2, 0.2).unwrap();
+        assert_eq!(shared(&a, &b), 1, "the written tile was copied");
+        assert_eq!(a.hits(4, 4), 0);
+        assert_eq!(b.hits(4, 4), 1);
+    }
+
+    #[test]
+    fn absurd_coordinates_are_refused_not_panicking() {
+        let mut m = TileMap::new(0.05);
+        m.add_hit(0.0, 0.0).unwrap();
+        assert_eq!(m.add_hit(1e9, 1e9), Err(TooLarge));
+        assert_eq!(m.hits(i32::MAX, i32::MIN), 0);
+        let _ = m.cell_of(f64::NAN, f64::INFINITY);
+    }
+}

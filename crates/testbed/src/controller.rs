@@ -1,0 +1,273 @@
+//! Controllers: pure pursuit along waypoints, and frontier exploration on the robot's own map.
+
+use mrslam_core::{CellState, OccupancyGrid, Pose2, pose_xyt};
+use nalgebra::Point2;
+use std::collections::VecDeque;
+
+/// Pure pursuit (Coulter 1992) along a polyline of waypoints, with speed and acceleration limits.
+#[derive(Debug, Clone)]
+pub struct PurePursuit {
+    /// Look-ahead distance, metres.
+    pub lookahead: f64,
+    /// Cruise speed, m/s.
+    pub speed: f64,
+    /// Largest turn rate, rad/s.
+    pub max_turn: f64,
+    /// Largest change of forward speed, m/s².
+    pub max_accel: f64,
+    /// The goal is reached within this distance, metres.
+    pub goal_tolerance: f64,
+    /// Turn on the spot first when the carrot is more than this far off the heading, radians.
+    pub turn_in_place: f64,
+    path: Vec<Point2<f64>>,
+    segment: usize,
+    v: f64,
+    done: bool,
+}
+
+impl PurePursuit {
+    /// Follows `path` from the robot's position at `speed`.
+    pub fn new(path: Vec<Point2<f64>>, speed: f64) -> Self {
+        PurePursuit {
+            lookahead: 0.6,
+            speed,
+            max_turn: 1.0,
+            max_accel: 0.5,
+            goal_tolerance: 0.1,
+            turn_in_place: 1.0,
+            done: path.is_empty(),
+            path,
+            segment: 0,
+            v: 0.0,
+        }
+    }
+
+    /// True once the last waypoint is reached.
+    pub fn is_done(&self) -> bool {
+        self.done
+    }
+
+    /// The carrot: the point one look-ahead ahead along the path.
+    fn carrot(&mut self, p: &Point2<f64>) -> Point2<f64> {
+        // Advance past waypoints already within the look-ahead circle.
+        while self.segment + 1 < self.path.len() && (self.path[self.segment] - p).norm() < self.lookahead {
+            self.segment += 1;
+        }
+        let target = self.path[self.segment];
+        if self.segment == 0 {
+            return target;
+        }
+        // Intersect the look-ahead circle with the current segment, taking the far intersection.
+        let a = self.path[self.segment - 1];
+        let d = target - a;
+        let f = a - p;
+        let (qa, qb, qc) = (d.dot(&d), 2.0 * f.dot(&d), f.dot(&f) - self.lookahead * self.lookahead);
+        let disc = qb * qb - 4.0 * qa * qc;
+        if qa > 1e-12 && disc >= 0.0 {
+            let t = (-qb + disc.sqrt()) / (2.0 * qa);
+            if (0.0..=1.0).contains(&t) {
+                return a + d * t;
+            }
+        }
+        target
+    }
+
+    /// Forward speed (m/s) and turn rate (rad/s) for the robot at `pose`, `dt` seconds after the last call.
+    pub fn command(&mut self, pose: &Pose2, dt: f64) -> (f64, f64) {
+        if self.done {
+            self.v = 0.0;
+            return (0.0, 0.0);
+        }
+        let (x, y, _) = pose_xyt(pose);
+        let p = Point2::new(x, y);
+        let goal = *self.path.last().expect("non-empty path");
+        let to_goal = (goal - p).norm();
+        let last = self.segment + 1 >= self.path.len();
+        if last && to_goal < self.goal_tolerance {
+            self.done = true;
+            self.v = 0.0;
+            return (0.0, 0.0);
+        }
+        let c = self.carrot(&p);
+        let local = pose.inverse_transform_point(&c);
+        let bearing = local.y.atan2(local.x);
+        if bearing.abs() > self.turn_in_place {
+            self.v = 0.0;
+            return (0.0, self.max_turn.copysign(bearing));
+        }
+        // Slow down for the goal and for sharp turns.
+        let v_goal = if last { (0.8 * to_goal).max(0.05) } else { self.speed };
+        let v_turn = self.speed * (1.0 - 0.7 * bearing.abs() / self.turn_in_place);
+        let v_target = self.speed.min(v_goal).min(v_turn);
+        self.v = v_target.clamp(self.v - self.max_accel * dt, self.v + self.max_accel * dt);
+        let curvature = 2.0 * local.y / local.coords.norm_squared().max(1e-6);
+        let w = (self.v.max(0.05) * curvature).clamp(-self.max_turn, self.max_turn);
+        (self.v, w)
+    }
+}
+
+/// Frontier exploration: drive to the nearest reachable frontier of the robot's own map, replan, repeat.
+///
+/// Works entirely in the SLAM map frame with the SLAM pose, as an autonomous robot must. Frontier cells are
+/// free cells next to unknown ones; reachability is a breadth-first search over free cells at least
+/// `clearance` from any occupied cell.
+#[derive(Debug, Clone)]
+pub struct Explorer {
+    /// Distance kept from walls when planning, metres.
+    pub clearance: f64,
+    /// Replan period, seconds.
+    pub replan_period: f64,
+    /// Cruise speed, m/s.
+    pub speed: f64,
+    follower: Option<PurePursuit>,
+    since_plan: f64,
+    finished: bool,
+}
+
+impl Explorer {
+    /// An explorer driving at `speed`, keeping `clearance` from walls.
+    pub fn new(speed: f64, clearance: f64) -> Self {
+        Explorer { clearance, replan_period: 3.0, speed, follower: None, since_plan: f64::INFINITY, finished: false }
+    }
+
+    /// True when no reachable frontier is left.
+    pub fn is_done(&self) -> bool {
+        self.finished
+    }
+
+    /// True when the explorer wants a fresh map to plan on.
+    pub fn wants_plan(&self) -> bool {
+        !self.finished
+            && (self.since_plan >= self.replan_period || self.follower.as_ref().is_none_or(PurePursuit::is_done))
+    }
+
+    /// Plans a path to the nearest frontier on `map` from `pose` (both in the SLAM frame).
+    pub fn plan(&mut self, map: &OccupancyGrid, pose: &Pose2) {
+        self.since_plan = 0.0;
+        match frontier_path(map, pose, self.clearance) {
+            Some(path) => self.follower = Some(PurePursuit::new(path, self.speed)),
+            None => {
+                self.follower = None;
+                self.finished = true;
+            }
+        }
+    }
+
+    /// Forward speed and turn rate for the robot at `pose` (SLAM frame).
+    pub fn command(&mut self, pose: &Pose2, dt: f64) -> (f64, f64) {
+        self.since_plan += dt;
+        match &mut self.follower {
+            Some(f) => f.command(pose, dt),
+            None => (0.0, 0.0),
+        }
+    }
+}
+
+/// Path (SLAM frame) to the nearest reachable frontier cell, thinned to one point every ~0.4 m.
+pub fn frontier_path(map: &OccupancyGrid, pose: &Pose2, clearance: f64) -> Option<Vec<Point2<f64>>> {
+    let (w, h) = (map.width(), map.height());
+    let r = (clearance / map.resolution()).ceil() as i64;
+    // Cells too close to a wall are blocked.
+    let mut blocked = vec![false; w * h];
+    for iy in 0..h {
+        for ix in 0..w {
+            if map.state(ix, iy) == CellState::Occupied {
+                for dy in -r..=r {
+                    for dx in -r..=r {
+                        let (x, y) = (ix as i64 + dx, iy as i64 + dy);
+                        if dx * dx + dy * dy <= r * r && map.contains_cell(x, y) {
+                            blocked[y as usize * w + x as usize] = true;
+                        }
+                    }
+                }
+            }
+        }
+    }
+    let start = map.world_to_cell(&Point2::new(pose.translation.x, pose.translation.y))?;
+    let s = start.1 * w + start.0;
+    let mut parent = vec![usize::MAX; w * h];
+    parent[s] = s;
+    let mut queue = VecDeque::from([s]);
+    let min_dist = (1.0 / map.resolution()) as i64; // ignore frontiers under the robot's nose
+    let free = |x: i64, y: i64| map.state(x as usize, y as usize) == CellState::Free;
+    while let Some(c) = queue.pop_front() {
+        let (cx, cy) = ((c % w) as i64, (c / w) as i64);
+        let frontier = free(cx, cy)
+            && [(1, 0), (-1, 0), (0, 1), (0, -1)].iter().any(|(dx, dy)| {
+                map.get_checked(cx + dx, cy + dy).is_some_and(|l| CellState::from_log_odds(l) == CellState::Unknown)
+            });
+        let far = (cx - start.0 as i64).abs() + (cy - start.1 as i64).abs() >= min_dist;
+        if frontier && far {
+            let mut cells = vec![c];
+            let mut k = c;
+            while parent[k] != k {
+                k = parent[k];
+                cells.push(k);
+            }
+            cells.reverse();
+            let step = ((0.4 / map.resolution()) as usize).max(1);
+            let mut path: Vec<Point2<f64>> =
+                cells.iter().step_by(step).map(|&k| map.cell_center((k % w) as i64, (k / w) as i64)).collect();
+            path.push(map.cell_center(cx, cy));
+            return Some(path);
+        }
+        for (dx, dy) in [(1i64, 0i64), (-1, 0), (0, 1), (0, -1)] {
+            let (nx, ny) = (cx + dx, cy + dy);
+            if !map.contains_cell(nx, ny) {
+                continue;
+            }
+            let n = ny as usize * w + nx as usize;
+            // The start cell may sit within the clearance of a wall; let the robot leave it.
+            let passable = free(nx, ny) && (!blocked[n] || c == s);
+            if parent[n] == usize::MAX && passable {
+                parent[n] = c;
+                queue.push_back(n);
+            }
+        }
+    }
+    None
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use mrslam_core::pose;
+
+    #[test]
+    fn pure_pursuit_drives_a_kinematic_robot_to_the_goal() {
+        let path = vec![Point2::new(2.0, 0.0), Point2::new(2.0, 2.0), Point2::new(0.0, 2.0)];
+        let mut pp = PurePursuit::new(path, 0.5);
+        let mut p = pose(0.0, 0.0, 0.0);
+        let dt = 0.02;
+        let mut t = 0.0;
+        while !pp.is_done() && t < 60.0 {
+            let (v, w) = pp.command(&p, dt);
+            let (x, y, th) = pose_xyt(&p);
+            p = pose(x + v * th.cos() * dt, y + v * th.sin() * dt, th + w * dt);
+            t += dt;
+            assert!(x > -0.3 && x < 2.3 && y > -0.3 && y < 2.3, "left the route at ({x}, {y})");
+        }
+        assert!(pp.is_done(), "did not arrive in 60 s");
+        let (x, y, _) = pose_xyt(&p);
+        assert!(x.hypot(y - 2.0) < 0.1);
+    }
+
+    #[test]
+    fn frontier_is_found_through_the_door() {
+        // A 4 m x 2 m known room, walled, with a gap in the east wall; unknown beyond.
+        let mut g = OccupancyGrid::new(120, 40, 0.05, pose(0.0, 0.0, 0.0)).unwrap();
+        for iy in 0..40 {
+            for ix in 0..80 {
+                let wall = ix == 0 || iy == 0 || iy == 39 || (ix == 79 && !(15..25).contains(&iy));
+                g.set(ix, iy, if wall { 2.0 } else { -2.0 });
+            }
+        }
+        let path = frontier_path(&g, &pose(1.0, 1.0, 0.0), 0.15).expect("a frontier");
+        let end = path.last().unwrap();
+        assert!(end.x > 3.9 && end.y > 0.7 && end.y < 1.3, "{end:?}");
+        for iy in 15..25 {
+            g.set(79, iy, 2.0);
+        }
+        assert!(frontier_path(&g, &pose(1.0, 1.0, 0.0), 0.15).is_none(), "closed door: nothing to explore");
+    }
+}

@@ -1,0 +1,348 @@
+//! The simulation loop: drive both robots, run their SLAMs, merge their maps, evaluate against truth.
+
+use crate::controller::{Explorer, PurePursuit};
+use crate::eval::{map_acceptance, rmse, transform_error};
+use crate::report::{MergeResult, RobotReport, RunReport};
+use crate::scenario::{ControllerKind, MergeWhen, RobotSetup, Scenario};
+use mrslam_core::map_io::{self, MapIoError};
+use mrslam_core::{CellTraversal, LaserScan, OccupancyGrid, Odometry, Pose2};
+use mrslam_merge::{MatchParams, MergeOutcome, MergeParams, Merger, SiftMerger, SiftMergerParams, TransformXyt, merge};
+use mrslam_sim::{RobotId, Sim, SimConfig, SimError};
+use mrslam_slam::{Rbpf, SlamError};
+use nalgebra::Point2;
+use std::collections::BTreeMap;
+use std::path::Path;
+use std::time::Instant;
+
+/// What can stop a run.
+#[derive(Debug, thiserror::Error)]
+pub enum RunError {
+    /// The simulator refused something (e.g. a start inside an obstacle).
+    #[error("simulator: {0}")]
+    Sim(#[from] SimError),
+    /// A SLAM filter refused its input or parameters.
+    #[error("SLAM of robot `{robot}`: {error}")]
+    Slam {
+        /// Robot.
+        robot: String,
+        /// What went wrong.
+        error: SlamError,
+    },
+    /// Writing outputs failed.
+    #[error("{0}")]
+    Io(#[from] MapIoError),
+    /// A merge algorithm name is not known.
+    #[error("unknown merge algorithm `{0}`")]
+    UnknownAlgorithm(String),
+}
+
+/// Options of a run that are not part of the scenario.
+#[derive(Default)]
+pub struct RunOptions<'a> {
+    /// Merge algorithms to run instead of the scenario's.
+    pub algorithms: Option<Vec<String>>,
+    /// Called about once per simulated second with (simulated time, duration).
+    pub progress: Option<Box<dyn FnMut(f64, f64) + 'a>>,
+}
+
+/// Everything a run produced.
+pub struct RunOutput {
+    /// The report.
+    pub report: RunReport,
+    /// Each robot's final map (best particle), by robot name, in its own SLAM frame.
+    pub maps: BTreeMap<String, OccupancyGrid>,
+    /// The true map (world frame).
+    pub truth: OccupancyGrid,
+    /// Merge outcomes, in algorithm order (with merged maps when accepted).
+    pub merges: Vec<MergeOutcome>,
+}
+
+/// Builds the merger a scenario names.
+pub fn merger_for(name: &str, scenario: &Scenario) -> Result<Box<dyn Merger>, RunError> {
+    let m = &scenario.merge;
+    match name {
+        "sift" => {
+            let mut p = SiftMergerParams {
+                model: m.model,
+                encoding: m.encoding,
+                matching: MatchParams { ratio: m.ratio, ..MatchParams::default() },
+                ..SiftMergerParams::default()
+            };
+            p.ransac.seed = scenario.seed;
+            Ok(Box::new(SiftMerger::new(p)))
+        }
+        other => Err(RunError::UnknownAlgorithm(other.to_string())),
+    }
+}
+
+/// Per-robot state of a run.
+struct Agent<'s> {
+    setup: &'s RobotSetup,
+    id: RobotId,
+    slam: Rbpf,
+    pursuit: Option<PurePursuit>,
+    explorer: Option<Explorer>,
+    /// (truth, odometry) at each processed scan, in the world and odometry frames.
+    processed: Vec<(Pose2, Pose2)>,
+    scans: usize,
+    distance: f64,
+    last: Pose2,
+    contact_steps: usize,
+    slam_s: f64,
+    /// Truth-map cells this robot's beams crossed or hit.
+    observed: Vec<bool>,
+}
+
+impl Agent<'_> {
+    fn finished(&self) -> bool {
+        match self.setup.controller {
+            ControllerKind::Waypoints => self.pursuit.as_ref().is_none_or(PurePursuit::is_done),
+            ControllerKind::Explore => self.explorer.as_ref().is_none_or(Explorer::is_done),
+        }
+    }
+
+    /// Feeds the scans of this step to SLAM, recording truth and odometry for evaluation.
+    fn process(&mut self, scans: Vec<(LaserScan, Odometry, Pose2)>, truth: &OccupancyGrid) -> Result<(), RunError> {
+        for (scan, odom, true_pose) in scans {
+            self.scans += 1;
+            mark_observed(&mut self.observed, truth, &scan, &(true_pose * self.setup.lidar.mount));
+            let t = Instant::now();
+            let outcome = self
+                .slam
+                .process(&odom, &scan)
+                .map_err(|error| RunError::Slam { robot: self.setup.name.clone(), error })?;
+            self.slam_s += t.elapsed().as_secs_f64();
+            if outcome.is_processed() {
+                self.processed.push((true_pose, odom.pose));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Marks the truth cells a scan's beams cross, from the sensor's true pose.
+fn mark_observed(observed: &mut [bool], truth: &OccupancyGrid, scan: &LaserScan, sensor: &Pose2) {
+    let origin = Point2::new(sensor.translation.x, sensor.translation.y);
+    let (x0, y0) = truth.world_to_cell_f(&origin);
+    let w = truth.width();
+    for i in (0..scan.len()).step_by(2) {
+        let r = if scan.is_valid(i) {
+            scan.ranges[i] as f64
+        } else if scan.is_max_range(i) {
+            scan.range_max as f64
+        } else {
+            continue;
+        };
+        let (x1, y1) = truth.world_to_cell_f(&scan.point_at(sensor, i, r));
+        for (cx, cy) in CellTraversal::new(x0, y0, x1, y1) {
+            if truth.contains_cell(cx, cy) {
+                observed[cy as usize * w + cx as usize] = true;
+            }
+        }
+    }
+}
+
+/// Runs a scenario end to end.
+pub fn run(scenario: &Scenario, mut opts: RunOptions) -> Result<RunOutput, RunError> {
+    let wall = Instant::now();
+    let config = SimConfig { dt: scenario.dt, ..SimConfig::default() };
+    let mut sim = Sim::with_config(&scenario.world, scenario.seed, config)?;
+    let truth = sim.true_map(scenario.truth_resolution)?;
+    let mut agents = Vec::new();
+    for (k, r) in scenario.robots.iter().enumerate() {
+        let id = sim.add_robot(&r.name, r.model.clone(), r.lidar.clone(), r.slip, r.encoder, r.start)?;
+        let slam = Rbpf::new(r.slam.clone(), r.lidar.mount, scenario.seed.wrapping_add(1 + k as u64))
+            .map_err(|error| RunError::Slam { robot: r.name.clone(), error })?;
+        let (pursuit, explorer) = match r.controller {
+            ControllerKind::Waypoints => (Some(PurePursuit::new(r.route.clone(), r.speed)), None),
+            ControllerKind::Explore => {
+                let clearance = r.model.footprint.bounding_radius() + 0.1;
+                (None, Some(Explorer::new(r.speed, clearance)))
+            }
+        };
+        agents.push(Agent {
+            setup: r,
+            id,
+            slam,
+            pursuit,
+            explorer,
+            processed: Vec::new(),
+            scans: 0,
+            distance: 0.0,
+            last: r.start,
+            contact_steps: 0,
+            slam_s: 0.0,
+            observed: vec![false; truth.width() * truth.height()],
+        });
+    }
+    let dt = scenario.dt;
+    let mut steps = 0u64;
+    let mut next_progress = 0.0;
+    loop {
+        let t = sim.time();
+        if let Some(p) = opts.progress.as_mut()
+            && t >= next_progress
+        {
+            p(t, scenario.duration);
+            next_progress += 1.0;
+        }
+        let merge_now = match scenario.merge.when {
+            MergeWhen::Rendezvous => agents.iter().all(Agent::finished),
+            MergeWhen::End => false,
+            MergeWhen::At(m) => t >= m - 1e-9,
+        };
+        if merge_now || t >= scenario.duration - 1e-9 {
+            break;
+        }
+        for a in agents.iter_mut() {
+            let true_pose = sim.true_pose(a.id)?;
+            let (v, w) = match (&mut a.pursuit, &mut a.explorer) {
+                // The scripted route is driven as an operator would: by looking at the robot.
+                (Some(p), _) => p.command(&true_pose, dt),
+                // Exploration is autonomous: the robot's own map and pose.
+                (_, Some(e)) => {
+                    let slam_pose = a.slam.best_pose();
+                    if e.wants_plan() && !a.processed.is_empty() {
+                        let map =
+                            a.slam.map().map_err(|error| RunError::Slam { robot: a.setup.name.clone(), error })?;
+                        e.plan(&map, &slam_pose);
+                    }
+                    e.command(&slam_pose, dt)
+                }
+                _ => (0.0, 0.0),
+            };
+            sim.set_velocity_command(a.id, v, w)?;
+        }
+        let events = sim.step();
+        steps += 1;
+        let mut batches = Vec::with_capacity(agents.len());
+        for (a, ev) in agents.iter_mut().zip(&events.robots) {
+            a.contact_steps += ev.contact as usize;
+            let pose = sim.true_pose(a.id)?;
+            a.distance += (pose.translation.vector - a.last.translation.vector).norm();
+            a.last = pose;
+            let mut batch = Vec::new();
+            while let Some(scan) = sim.take_scan(a.id)? {
+                batch.push((scan, sim.odometry(a.id)?, pose));
+            }
+            batches.push(batch);
+        }
+        // The two filters are independent: update them side by side.
+        let (first, rest) = agents.split_at_mut(1);
+        let (b0, b1) = {
+            let mut it = batches.into_iter();
+            (it.next().unwrap_or_default(), it.next().unwrap_or_default())
+        };
+        let (r0, r1) = rayon::join(|| first[0].process(b0, &truth), || rest[0].process(b1, &truth));
+        r0?;
+        r1?;
+    }
+    let merge_at = sim.time();
+
+    // Evaluation.
+    let mut robots = BTreeMap::new();
+    let mut maps = BTreeMap::new();
+    let mut frames = BTreeMap::new();
+    for a in &agents {
+        let map = a.slam.map().map_err(|error| RunError::Slam { robot: a.setup.name.clone(), error })?;
+        let traj: Vec<Pose2> = a.slam.trajectory().into_iter().map(|(_, p)| p).collect();
+        let (t0, o0) = a.processed.first().copied().unwrap_or((a.setup.start, Pose2::identity()));
+        let truth_rel: Vec<Pose2> = a.processed.iter().map(|(t, _)| t0.inv_mul(t)).collect();
+        let odom_rel: Vec<Pose2> = a.processed.iter().map(|(_, o)| o0.inv_mul(o)).collect();
+        let final_err = |est: &[Pose2]| match (est.last(), truth_rel.last()) {
+            (Some(e), Some(t)) => (e.translation.vector - t.translation.vector).norm(),
+            _ => 0.0,
+        };
+        let counters = a.slam.counters();
+        robots.insert(
+            a.setup.name.clone(),
+            RobotReport {
+                slam_rmse_m: rmse(&traj, &truth_rel),
+                odom_rmse_m: rmse(&odom_rel, &truth_rel),
+                map_acceptance: map_acceptance(&truth, &map, &t0),
+                slam_final_error_m: final_err(&traj),
+                odom_final_error_m: final_err(&odom_rel),
+                scans: a.scans,
+                processed: counters.processed,
+                resamples: counters.resamples,
+                final_neff: a.slam.neff(),
+                distance_m: a.distance,
+                contact_steps: a.contact_steps,
+                finished: a.finished(),
+                slam_s: a.slam_s,
+            },
+        );
+        frames.insert(a.setup.name.clone(), t0);
+        maps.insert(a.setup.name.clone(), map);
+    }
+    let host = scenario.merge.host.clone();
+    let other = scenario.robots.iter().map(|r| r.name.clone()).find(|n| *n != host).expect("two robots");
+    let true_t = frames[&host].inv_mul(&frames[&other]);
+    let algorithms = opts.algorithms.clone().unwrap_or_else(|| scenario.merge.algorithms.clone());
+    let mut merges = Vec::new();
+    let mut results = Vec::new();
+    for name in &algorithms {
+        let merger = merger_for(name, scenario)?;
+        let out = merge(merger.as_ref(), &maps[&host], &maps[&other], &MergeParams::default());
+        let err = out.report.transform.map(|t| transform_error(&t.to_pose(), &true_t));
+        let success = out.report.accepted
+            && err.is_some_and(|(r, t)| {
+                r.to_degrees() <= scenario.success.rotation_deg && t <= scenario.success.translation_m
+            });
+        results.push(MergeResult {
+            algorithm: name.clone(),
+            accepted: out.report.accepted,
+            success,
+            rotation_error_deg: err.map(|e| e.0.to_degrees()),
+            translation_error_m: err.map(|e| e.1),
+            acceptance_index: out.report.acceptance_index,
+            merged_map_acceptance: out.merged.as_ref().map(|m| map_acceptance(&truth, m, &frames[&host])),
+            time_ms: out.report.time_ms,
+            reason: out.report.reason.clone(),
+            transform: out.report.transform,
+            true_transform: TransformXyt::from_pose(&true_t),
+            inliers: out.report.inliers,
+            matches: out.report.matches,
+        });
+        merges.push(out);
+    }
+    let (oa, ob) = (&agents[0].observed, &agents[1].observed);
+    let both = oa.iter().zip(ob).filter(|(x, y)| **x && **y).count();
+    let either = oa.iter().zip(ob).filter(|(x, y)| **x || **y).count();
+    let report = RunReport {
+        scenario: scenario.name.clone(),
+        seed: scenario.seed,
+        sim_s: merge_at,
+        wall_s: wall.elapsed().as_secs_f64(),
+        steps,
+        merge_at_s: merge_at,
+        merge_pair: [host, other],
+        robots,
+        merges: results,
+        observed_overlap: if either == 0 { 0.0 } else { both as f64 / either as f64 },
+    };
+    Ok(RunOutput { report, maps, truth, merges })
+}
+
+/// Writes a run's maps (PGM+YAML), the true map, merged maps and `report.json` (last) into `dir`.
+pub fn write_outputs(out: &RunOutput, dir: &Path) -> Result<(), RunError> {
+    std::fs::create_dir_all(dir).map_err(|cause| MapIoError::Io { path: dir.to_path_buf(), cause })?;
+    for (name, map) in &out.maps {
+        map_io::write_ros_map(map, &dir.join(format!("{name}.yaml")))?;
+    }
+    map_io::write_ros_map(&out.truth, &dir.join("truth.yaml"))?;
+    for m in &out.merges {
+        let path = dir.join(format!("merged_{}.yaml", m.report.algorithm));
+        match &m.merged {
+            Some(g) => map_io::write_ros_map(g, &path)?,
+            None => {
+                // A rejected merge leaves no map, not even a stale one from an earlier run.
+                let _ = std::fs::remove_file(&path);
+                let _ = std::fs::remove_file(path.with_extension("pgm"));
+            }
+        }
+    }
+    let json = serde_json::to_vec_pretty(&out.report).expect("reports serialise");
+    map_io::write_file_atomic(&dir.join("report.json"), &json)?;
+    Ok(())
+}

@@ -1,0 +1,627 @@
+//! Scenario files: the world, the robots, their routes and sensors, SLAM and merge settings, success criteria.
+//!
+//! A scenario is TOML (see `scenarios/paper_corridor.toml`); paths inside it are relative to the file.
+//! Every error names the file, the line and the field at fault.
+
+use mrslam_core::{Pose2, pose};
+use mrslam_merge::{MapEncoding, Model};
+use mrslam_sim::{EncoderParams, LidarModel, RobotModel, SlipParams, World, WorldSpec};
+use mrslam_slam::SlamParams;
+use nalgebra::Point2;
+use serde::Deserialize;
+use std::path::{Path, PathBuf};
+
+/// A scenario error, naming the file, line and field.
+#[derive(Debug, thiserror::Error)]
+#[error("{path}:{line}: {field}: {message}")]
+pub struct ScenarioError {
+    /// File at fault.
+    pub path: PathBuf,
+    /// 1-based line (0 when the problem is not tied to one line).
+    pub line: usize,
+    /// Dotted path of the field, e.g. `robots[1].lidar`.
+    pub field: String,
+    /// What is wrong.
+    pub message: String,
+}
+
+/// How a robot is driven.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ControllerKind {
+    /// Pure pursuit along the scripted route (the paper's robots were driven by hand along such routes).
+    Waypoints,
+    /// Frontier-based exploration on the robot's own SLAM map.
+    Explore,
+}
+
+/// When the maps are merged.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum MergeWhen {
+    /// When every robot has finished its route (the paper's common point), or at the duration at the latest.
+    Rendezvous,
+    /// At the end of the run.
+    End,
+    /// At this simulated time, seconds; the run ends there.
+    At(f64),
+}
+
+/// One robot of a scenario, resolved.
+#[derive(Debug, Clone)]
+pub struct RobotSetup {
+    /// Name (also the map's file name and rerun entity).
+    pub name: String,
+    /// Body and wheels.
+    pub model: RobotModel,
+    /// Lidar.
+    pub lidar: LidarModel,
+    /// Wheel slip process.
+    pub slip: SlipParams,
+    /// Encoders and odometry calibration.
+    pub encoder: EncoderParams,
+    /// SLAM parameters.
+    pub slam: SlamParams,
+    /// Start pose in the world (hidden from SLAM and merge; only the evaluator knows it).
+    pub start: Pose2,
+    /// Waypoints in the world frame.
+    pub route: Vec<Point2<f64>>,
+    /// Controller.
+    pub controller: ControllerKind,
+    /// Cruise speed, m/s.
+    pub speed: f64,
+}
+
+/// Merge settings.
+#[derive(Debug, Clone)]
+pub struct MergeSetup {
+    /// When to merge.
+    pub when: MergeWhen,
+    /// Algorithms to run on the same maps, in order.
+    pub algorithms: Vec<String>,
+    /// Transform model of the SIFT merger.
+    pub model: Model,
+    /// Lowe's ratio.
+    pub ratio: f32,
+    /// Map-to-image encoding.
+    pub encoding: MapEncoding,
+    /// Robot that hosts the merge (the paper: Experia); the other's map is merged into its frame.
+    pub host: String,
+}
+
+/// A merge counts as a success when accepted and within these errors of the truth.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct Success {
+    /// Largest rotation error, degrees.
+    pub rotation_deg: f64,
+    /// Largest translation error, metres.
+    pub translation_m: f64,
+}
+
+/// A resolved scenario, ready to run.
+#[derive(Debug, Clone)]
+pub struct Scenario {
+    /// Name (default: the file stem).
+    pub name: String,
+    /// The scenario file.
+    pub path: PathBuf,
+    /// The world file.
+    pub world_path: PathBuf,
+    /// The world.
+    pub world: WorldSpec,
+    /// Seed of every random draw.
+    pub seed: u64,
+    /// Longest simulated time, seconds.
+    pub duration: f64,
+    /// Physics step, seconds.
+    pub dt: f64,
+    /// Resolution of the ground-truth map, metres.
+    pub truth_resolution: f64,
+    /// The robots.
+    pub robots: Vec<RobotSetup>,
+    /// Merge settings.
+    pub merge: MergeSetup,
+    /// Success thresholds.
+    pub success: Success,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ScenarioFile {
+    name: Option<String>,
+    #[allow(dead_code)]
+    description: Option<String>,
+    world: String,
+    seed: u64,
+    duration: f64,
+    dt: Option<f64>,
+    truth_resolution: Option<f64>,
+    robots: Vec<RobotFile>,
+    #[serde(default)]
+    merge: MergeFile,
+    #[serde(default)]
+    success: SuccessFile,
+}
+
+#[derive(Deserialize)]
+#[serde(untagged)]
+enum PoseRef {
+    Named(String),
+    Xyt([f64; 3]),
+}
+
+#[derive(Deserialize)]
+#[serde(untagged)]
+enum PointRef {
+    Named(String),
+    Xy([f64; 2]),
+}
+
+#[derive(Deserialize)]
+#[serde(untagged)]
+enum LidarRef {
+    Preset(String),
+    Table(LidarFile),
+}
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct LidarFile {
+    preset: Option<String>,
+    fov_deg: Option<f64>,
+    resolution_deg: Option<f64>,
+    range_min: Option<f64>,
+    range_max: Option<f64>,
+    scan_period: Option<f64>,
+    range_noise_const: Option<f64>,
+    range_noise_prop: Option<f64>,
+    angular_jitter_deg: Option<f64>,
+    dropout_prob: Option<f64>,
+    mount: Option<[f64; 3]>,
+    skew: Option<bool>,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct SlipFile {
+    none: Option<bool>,
+    speed_noise: Option<f64>,
+    turn_noise: Option<f64>,
+    noise_correlation_time: Option<f64>,
+    event_rate: Option<f64>,
+    event_turn_gain: Option<f64>,
+    event_duration: Option<f64>,
+    event_magnitude: Option<f64>,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct EncoderFile {
+    ticks_per_rev: Option<u32>,
+    left_radius_error: Option<f64>,
+    right_radius_error: Option<f64>,
+    wheel_base_error: Option<f64>,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct SlamFile {
+    preset: Option<String>,
+    particles: Option<usize>,
+    delta: Option<f64>,
+    linear_update: Option<f64>,
+    angular_update: Option<f64>,
+    resample_threshold: Option<f64>,
+    sigma: Option<f64>,
+    lsigma: Option<f64>,
+    ogain: Option<f64>,
+    lstep: Option<f64>,
+    astep: Option<f64>,
+    iterations: Option<u32>,
+    lskip: Option<usize>,
+    minimum_score: Option<f64>,
+    srr: Option<f64>,
+    srt: Option<f64>,
+    str: Option<f64>,
+    stt: Option<f64>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RobotFile {
+    name: String,
+    model: String,
+    lidar: LidarRef,
+    start: PoseRef,
+    #[serde(default)]
+    route: Vec<PointRef>,
+    controller: Option<String>,
+    speed: Option<f64>,
+    #[serde(default)]
+    slip: SlipFile,
+    #[serde(default)]
+    encoder: EncoderFile,
+    #[serde(default)]
+    slam: SlamFile,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct MergeFile {
+    when: Option<toml::Value>,
+    algorithms: Option<Vec<String>>,
+    model: Option<String>,
+    ratio: Option<f32>,
+    encoding: Option<String>,
+    host: Option<String>,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct SuccessFile {
+    rotation_deg: Option<f64>,
+    translation_m: Option<f64>,
+}
+
+/// Merge algorithms a scenario may name.
+pub const ALGORITHMS: &[&str] = &["sift"];
+
+/// The 1-based line of the first line of `text` containing `needle` (0 when absent).
+fn line_of(text: &str, needle: &str) -> usize {
+    text.lines().position(|l| l.contains(needle)).map_or(0, |i| i + 1)
+}
+
+/// The 1-based line of a byte offset.
+fn line_at(text: &str, offset: usize) -> usize {
+    text[..offset.min(text.len())].matches('\n').count() + 1
+}
+
+struct Ctx<'a> {
+    path: &'a Path,
+    text: &'a str,
+}
+
+impl Ctx<'_> {
+    /// An error on `field`, located at the first line containing `needle`.
+    fn err(&self, field: impl Into<String>, needle: &str, message: impl Into<String>) -> ScenarioError {
+        ScenarioError {
+            path: self.path.to_path_buf(),
+            line: line_of(self.text, needle),
+            field: field.into(),
+            message: message.into(),
+        }
+    }
+}
+
+/// Overwrites each destination with its source value when one is given.
+fn apply<T: Copy>(pairs: &mut [(&mut T, Option<T>)]) {
+    for (dst, src) in pairs.iter_mut() {
+        if let Some(v) = *src {
+            **dst = v;
+        }
+    }
+}
+
+impl Scenario {
+    /// Reads and resolves a scenario file (and the world it names).
+    pub fn from_file(path: &Path) -> Result<Scenario, ScenarioError> {
+        let text = std::fs::read_to_string(path).map_err(|e| ScenarioError {
+            path: path.to_path_buf(),
+            line: 0,
+            field: "file".into(),
+            message: e.to_string(),
+        })?;
+        Self::parse(&text, path)
+    }
+
+    /// Resolves a scenario from its text; `path` names it in errors and anchors relative paths.
+    pub fn parse(text: &str, path: &Path) -> Result<Scenario, ScenarioError> {
+        let cx = Ctx { path, text };
+        let file: ScenarioFile = toml::from_str(text).map_err(|e| {
+            let line = e.span().map_or(0, |s| line_at(text, s.start));
+            ScenarioError { path: path.to_path_buf(), line, field: "toml".into(), message: e.message().to_string() }
+        })?;
+        let dir = path.parent().unwrap_or(Path::new("."));
+        let world_path = dir.join(&file.world);
+        let world = WorldSpec::from_toml_file(&world_path)
+            .map_err(|e| cx.err("world", "world", format!("cannot load world `{}`: {e}", file.world)))?;
+        let built = World::from_spec(&world).map_err(|e| cx.err("world", "world", e.to_string()))?;
+        if !(file.duration.is_finite() && file.duration > 0.0) {
+            return Err(cx.err("duration", "duration", format!("must be positive, got {}", file.duration)));
+        }
+        let dt = file.dt.unwrap_or(0.01);
+        if !(dt > 0.0 && dt <= 0.1) {
+            return Err(cx.err("dt", "dt", format!("must lie in (0, 0.1] s, got {dt}")));
+        }
+        let truth_resolution = file.truth_resolution.unwrap_or(0.05);
+        if !(truth_resolution > 0.0 && truth_resolution.is_finite()) {
+            return Err(cx.err("truth_resolution", "truth_resolution", "must be positive"));
+        }
+        if file.robots.len() != 2 {
+            return Err(cx.err("robots", "[[robots]]", format!("need two robots, found {}", file.robots.len())));
+        }
+        let robots = file
+            .robots
+            .iter()
+            .enumerate()
+            .map(|(i, r)| resolve_robot(&cx, i, r, &world, &built))
+            .collect::<Result<Vec<_>, _>>()?;
+        if robots[0].name == robots[1].name {
+            return Err(cx.err("robots[1].name", &robots[1].name, "two robots share this name"));
+        }
+        let merge = resolve_merge(&cx, &file.merge, &robots, file.duration)?;
+        let success = Success {
+            rotation_deg: file.success.rotation_deg.unwrap_or(2.0),
+            translation_m: file.success.translation_m.unwrap_or(0.3),
+        };
+        let name = file
+            .name
+            .clone()
+            .unwrap_or_else(|| path.file_stem().map_or("scenario".into(), |s| s.to_string_lossy().into_owned()));
+        Ok(Scenario {
+            name,
+            path: path.to_path_buf(),
+            world_path,
+            world,
+            seed: file.seed,
+            duration: file.duration,
+            dt,
+            truth_resolution,
+            robots,
+            merge,
+            success,
+        })
+    }
+}
+
+fn resolve_pose(cx: &Ctx, field: &str, r: &PoseRef, world: &WorldSpec) -> Result<Pose2, ScenarioError> {
+    match r {
+        PoseRef::Named(n) => {
+            world.named_pose(n).ok_or_else(|| cx.err(field, n, format!("no point named `{n}` in the world")))
+        }
+        PoseRef::Xyt([x, y, t]) => Ok(pose(*x, *y, *t)),
+    }
+}
+
+fn resolve_robot(
+    cx: &Ctx,
+    i: usize,
+    r: &RobotFile,
+    spec: &WorldSpec,
+    world: &World,
+) -> Result<RobotSetup, ScenarioError> {
+    let f = |name: &str| format!("robots[{i}].{name}");
+    let model = match r.model.as_str() {
+        "experia" => RobotModel::experia(),
+        "prawn" => RobotModel::prawn(),
+        m => return Err(cx.err(f("model"), m, format!("unknown robot model `{m}` (expected experia or prawn)"))),
+    };
+    let lidar = resolve_lidar(cx, &f("lidar"), &r.lidar)?;
+    let mut slip = if r.slip.none == Some(true) { SlipParams::none() } else { SlipParams::default() };
+    let s = &r.slip;
+    apply(&mut [
+        (&mut slip.speed_noise, s.speed_noise),
+        (&mut slip.turn_noise, s.turn_noise),
+        (&mut slip.noise_correlation_time, s.noise_correlation_time),
+        (&mut slip.event_rate, s.event_rate),
+        (&mut slip.event_turn_gain, s.event_turn_gain),
+        (&mut slip.event_duration, s.event_duration),
+        (&mut slip.event_magnitude, s.event_magnitude),
+    ]);
+    slip.validate().map_err(|e| cx.err(f("slip"), "slip", e.to_string()))?;
+    let mut encoder = EncoderParams::default();
+    let e = &r.encoder;
+    apply(&mut [(&mut encoder.ticks_per_rev, e.ticks_per_rev)]);
+    apply(&mut [
+        (&mut encoder.left_radius_error, e.left_radius_error),
+        (&mut encoder.right_radius_error, e.right_radius_error),
+        (&mut encoder.wheel_base_error, e.wheel_base_error),
+    ]);
+    encoder.validate().map_err(|er| cx.err(f("encoder"), "encoder", er.to_string()))?;
+    let slam = resolve_slam(cx, &f("slam"), &r.slam, &lidar)?;
+    let start = resolve_pose(cx, &f("start"), &r.start, spec)?;
+    if world.footprint_collides(&model.footprint, &start) {
+        let (x, y) = (start.translation.x, start.translation.y);
+        let needle = match &r.start {
+            PoseRef::Named(n) => n.clone(),
+            PoseRef::Xyt(_) => "start".into(),
+        };
+        return Err(cx.err(
+            f("start"),
+            &needle,
+            format!("robot `{}` would start inside an obstacle at ({x:.2}, {y:.2})", r.name),
+        ));
+    }
+    let (lo, hi) = world.bounds();
+    let mut route = Vec::new();
+    for (k, w) in r.route.iter().enumerate() {
+        let field = format!("robots[{i}].route[{k}]");
+        let (p, needle) = match w {
+            PointRef::Named(n) => {
+                let p = spec
+                    .named_pose(n)
+                    .ok_or_else(|| cx.err(&field, n, format!("no point named `{n}` in the world")))?;
+                (Point2::new(p.translation.x, p.translation.y), n.clone())
+            }
+            PointRef::Xy([x, y]) => (Point2::new(*x, *y), "route".to_string()),
+        };
+        if p.x < lo.x || p.y < lo.y || p.x > hi.x || p.y > hi.y {
+            return Err(cx.err(
+                &field,
+                &needle,
+                format!(
+                    "waypoint ({:.2}, {:.2}) lies outside the world ({:.1}..{:.1} x {:.1}..{:.1})",
+                    p.x, p.y, lo.x, hi.x, lo.y, hi.y
+                ),
+            ));
+        }
+        if world.footprint_collides(&model.footprint, &pose(p.x, p.y, 0.0)) {
+            return Err(cx.err(
+                &field,
+                &needle,
+                format!("the robot cannot stand at waypoint ({:.2}, {:.2}): it overlaps an obstacle", p.x, p.y),
+            ));
+        }
+        route.push(p);
+    }
+    let controller = match r.controller.as_deref().unwrap_or("waypoints") {
+        "waypoints" => ControllerKind::Waypoints,
+        "explore" => ControllerKind::Explore,
+        c => {
+            return Err(cx.err(
+                f("controller"),
+                c,
+                format!("unknown controller `{c}` (expected waypoints or explore)"),
+            ));
+        }
+    };
+    if controller == ControllerKind::Waypoints && route.is_empty() {
+        return Err(cx.err(f("route"), &r.name, "the waypoint controller needs a route"));
+    }
+    let speed = r.speed.unwrap_or(0.4);
+    if !(speed > 0.0 && speed <= model.max_speed) {
+        return Err(cx.err(
+            f("speed"),
+            "speed",
+            format!("must lie in (0, {}] m/s for this robot, got {speed}", model.max_speed),
+        ));
+    }
+    Ok(RobotSetup { name: r.name.clone(), model, lidar, slip, encoder, slam, start, route, controller, speed })
+}
+
+fn resolve_lidar(cx: &Ctx, field: &str, r: &LidarRef) -> Result<LidarModel, ScenarioError> {
+    let preset = |name: &str| match name {
+        "hokuyo_urg_04lx" => Ok(LidarModel::hokuyo_urg_04lx()),
+        "rplidar_a1" => Ok(LidarModel::rplidar_a1()),
+        other => Err(cx.err(
+            field,
+            other,
+            format!("unknown lidar preset `{other}` (expected hokuyo_urg_04lx or rplidar_a1)"),
+        )),
+    };
+    let lidar = match r {
+        LidarRef::Preset(name) => preset(name)?,
+        LidarRef::Table(t) => {
+            let mut l = match &t.preset {
+                Some(p) => preset(p)?,
+                None => LidarModel::hokuyo_urg_04lx(),
+            };
+            apply(&mut [
+                (&mut l.fov, t.fov_deg.map(f64::to_radians)),
+                (&mut l.resolution, t.resolution_deg.map(f64::to_radians)),
+                (&mut l.angular_jitter, t.angular_jitter_deg.map(f64::to_radians)),
+                (&mut l.range_min, t.range_min),
+                (&mut l.range_max, t.range_max),
+                (&mut l.scan_period, t.scan_period),
+                (&mut l.range_noise_const, t.range_noise_const),
+                (&mut l.range_noise_prop, t.range_noise_prop),
+                (&mut l.dropout_prob, t.dropout_prob),
+            ]);
+            if let Some([x, y, th]) = t.mount {
+                l.mount = pose(x, y, th);
+            }
+            apply(&mut [(&mut l.skew, t.skew)]);
+            l
+        }
+    };
+    lidar.validate().map_err(|e| cx.err(field, "lidar", e.to_string()))?;
+    Ok(lidar)
+}
+
+fn resolve_slam(cx: &Ctx, field: &str, s: &SlamFile, lidar: &LidarModel) -> Result<SlamParams, ScenarioError> {
+    let mut p = match s.preset.as_deref() {
+        Some("hokuyo") => SlamParams::hokuyo(),
+        Some("rplidar") => SlamParams::rplidar(),
+        Some("gmapping") => SlamParams::default(),
+        Some(other) => {
+            return Err(cx.err(
+                field,
+                other,
+                format!("unknown SLAM preset `{other}` (expected hokuyo, rplidar or gmapping)"),
+            ));
+        }
+        // Without a preset, the one matching the lidar's reach.
+        None if lidar.range_max <= 4.5 => SlamParams::hokuyo(),
+        None => SlamParams::rplidar(),
+    };
+    apply(&mut [(&mut p.particles, s.particles), (&mut p.lskip, s.lskip)]);
+    apply(&mut [(&mut p.iterations, s.iterations)]);
+    apply(&mut [
+        (&mut p.delta, s.delta),
+        (&mut p.linear_update, s.linear_update),
+        (&mut p.angular_update, s.angular_update),
+        (&mut p.resample_threshold, s.resample_threshold),
+        (&mut p.sigma, s.sigma),
+        (&mut p.lsigma, s.lsigma),
+        (&mut p.ogain, s.ogain),
+        (&mut p.lstep, s.lstep),
+        (&mut p.astep, s.astep),
+        (&mut p.minimum_score, s.minimum_score),
+        (&mut p.srr, s.srr),
+        (&mut p.srt, s.srt),
+        (&mut p.str, s.str),
+        (&mut p.stt, s.stt),
+    ]);
+    // The filter sees no farther than the lidar.
+    p.max_range = p.max_range.min(lidar.range_max);
+    p.max_urange = p.max_urange.min(lidar.range_max);
+    p.validate().map_err(|e| cx.err(field, "slam", e))?;
+    Ok(p)
+}
+
+fn resolve_merge(cx: &Ctx, m: &MergeFile, robots: &[RobotSetup], duration: f64) -> Result<MergeSetup, ScenarioError> {
+    let when = match &m.when {
+        None => MergeWhen::Rendezvous,
+        Some(toml::Value::String(s)) if s == "rendezvous" => MergeWhen::Rendezvous,
+        Some(toml::Value::String(s)) if s == "end" => MergeWhen::End,
+        Some(toml::Value::Float(t)) => MergeWhen::At(*t),
+        Some(toml::Value::Integer(t)) => MergeWhen::At(*t as f64),
+        Some(v) => {
+            return Err(cx.err(
+                "merge.when",
+                "when",
+                format!("expected \"rendezvous\", \"end\" or a time in seconds, got {v}"),
+            ));
+        }
+    };
+    if let MergeWhen::At(t) = when {
+        if !(t > 0.0) {
+            return Err(cx.err("merge.when", "when", format!("merge time must be positive, got {t}")));
+        }
+        if t > duration {
+            return Err(cx.err(
+                "merge.when",
+                "when",
+                format!("merge time {t} s is after the end of the run ({duration} s)"),
+            ));
+        }
+    }
+    let algorithms = m.algorithms.clone().unwrap_or_else(|| vec!["sift".to_string()]);
+    for a in &algorithms {
+        if !ALGORITHMS.contains(&a.as_str()) {
+            return Err(cx.err(
+                "merge.algorithms",
+                a,
+                format!("unknown algorithm `{a}` (expected one of {})", ALGORITHMS.join(", ")),
+            ));
+        }
+    }
+    let model = match &m.model {
+        None => Model::Rigid,
+        Some(s) => s.parse().map_err(|e: String| cx.err("merge.model", s, e))?,
+    };
+    let ratio = m.ratio.unwrap_or(0.75);
+    if !(ratio > 0.0 && ratio <= 1.0) {
+        return Err(cx.err("merge.ratio", "ratio", format!("must lie in (0, 1], got {ratio}")));
+    }
+    let encoding = match m.encoding.as_deref() {
+        None | Some("walls") => MapEncoding::WALLS,
+        Some("paper") => MapEncoding::PAPER,
+        Some(e) => {
+            return Err(cx.err("merge.encoding", e, format!("unknown encoding `{e}` (expected walls or paper)")));
+        }
+    };
+    let host = m.host.clone().unwrap_or_else(|| robots[0].name.clone());
+    if !robots.iter().any(|r| r.name == host) {
+        return Err(cx.err("merge.host", &host, format!("no robot named `{host}`")));
+    }
+    Ok(MergeSetup { when, algorithms, model, ratio, encoding, host })
+}

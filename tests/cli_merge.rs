@@ -1,0 +1,124 @@
+//! `mrslam merge` and `mrslam map cut`, run as a user would.
+
+use mrslam_core::map_io::{read_ros_map, write_ros_map};
+use mrslam_merge::floorplan::{FloorplanParams, generate};
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn mrslam(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_mrslam")).args(args).output().expect("mrslam runs")
+}
+
+fn text(b: &[u8]) -> String {
+    String::from_utf8_lossy(b).into_owned()
+}
+
+fn p(path: &Path) -> &str {
+    path.to_str().unwrap()
+}
+
+#[test]
+fn cut_then_merge_recovers_the_printed_transform() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    write_ros_map(&generate(21, &FloorplanParams::default()), &d.join("plan.yaml")).unwrap();
+    let o = mrslam(&["map", "cut", p(&d.join("plan.yaml")), p(&d.join("a.yaml")), p(&d.join("b.yaml")), "--seed", "3"]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let out = text(&o.stdout);
+    let truth: Vec<f64> = out
+        .lines()
+        .find(|l| l.starts_with("true transform"))
+        .unwrap()
+        .split_whitespace()
+        .filter_map(|w| w.parse().ok())
+        .collect();
+    let (tx, ty, tth) = (truth[0], truth[1], truth[2]);
+
+    let o = mrslam(&[
+        "merge",
+        p(&d.join("a.yaml")),
+        p(&d.join("b.yaml")),
+        "-o",
+        p(&d.join("merged.yaml")),
+        "--report",
+        p(&d.join("report.json")),
+        "--matches-png",
+        p(&d.join("matches.png")),
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}{}", text(&o.stdout), text(&o.stderr));
+    assert!(text(&o.stdout).contains("ACCEPTED"));
+    let report: serde_json::Value = serde_json::from_slice(&std::fs::read(d.join("report.json")).unwrap()).unwrap();
+    for key in ["accepted", "algorithm", "transform", "scale", "matches", "inliers", "confidence", "acceptance_index"] {
+        assert!(report.get(key).is_some(), "report lacks {key}: {report}");
+    }
+    assert!(report["time_ms"].as_f64().unwrap() > 0.0);
+    assert!(report["timings_ms"]["features"].as_f64().is_some());
+    let t = &report["transform"];
+    assert!((t["x"].as_f64().unwrap() - tx).abs() < 0.1, "{t} vs {truth:?}");
+    assert!((t["y"].as_f64().unwrap() - ty).abs() < 0.1, "{t} vs {truth:?}");
+    assert!((t["theta"].as_f64().unwrap() - tth).abs() < 0.02, "{t} vs {truth:?}");
+    let merged = read_ros_map(&d.join("merged.yaml")).unwrap();
+    assert!(merged.state_counts().0 > read_ros_map(&d.join("a.yaml")).unwrap().state_counts().0);
+    let png = image::open(d.join("matches.png")).unwrap();
+    assert!(png.width() > 100 && png.height() > 100);
+}
+
+#[test]
+fn rejected_merge_exits_2_and_writes_no_map() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    write_ros_map(&generate(22, &FloorplanParams::default()), &d.join("plan.yaml")).unwrap();
+    let o = mrslam(&[
+        "map",
+        "cut",
+        p(&d.join("plan.yaml")),
+        p(&d.join("a.yaml")),
+        p(&d.join("b.yaml")),
+        "--overlap",
+        "-0.2",
+    ]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let o = mrslam(&[
+        "merge",
+        p(&d.join("a.yaml")),
+        p(&d.join("b.yaml")),
+        "-o",
+        p(&d.join("merged.yaml")),
+        "--report",
+        p(&d.join("report.json")),
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}{}", text(&o.stdout), text(&o.stderr));
+    assert!(text(&o.stdout).contains("REJECTED") && text(&o.stdout).contains("reason:"));
+    assert!(!d.join("merged.yaml").exists() && !d.join("merged.pgm").exists());
+    let report: serde_json::Value = serde_json::from_slice(&std::fs::read(d.join("report.json")).unwrap()).unwrap();
+    assert_eq!(report["accepted"], false);
+    assert!(report["reason"].as_str().is_some_and(|r| !r.is_empty()));
+}
+
+#[test]
+fn one_colour_map_is_rejected_not_a_crash() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    write_ros_map(&generate(23, &FloorplanParams::default()), &d.join("a.yaml")).unwrap();
+    std::fs::write(d.join("white.pgm"), [b"P5\n50 40\n255\n".as_slice(), &[254u8; 2000]].concat()).unwrap();
+    std::fs::write(d.join("white.yaml"), "image: white.pgm\nresolution: 0.05\norigin: [0, 0, 0]\n").unwrap();
+    let o = mrslam(&["merge", p(&d.join("a.yaml")), p(&d.join("white.yaml")), "-o", p(&d.join("m.yaml"))]);
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o.stderr));
+    assert!(!text(&o.stderr).contains("panicked"));
+    assert!(!d.join("m.yaml").exists());
+}
+
+#[test]
+fn unreadable_map_exits_1_naming_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    write_ros_map(&generate(24, &FloorplanParams::default()), &d.join("a.yaml")).unwrap();
+    std::fs::write(d.join("broken.yaml"), "image: a.pgm\nresolution: fast\norigin: [0, 0, 0]\n").unwrap();
+    let o = mrslam(&["merge", p(&d.join("a.yaml")), p(&d.join("broken.yaml")), "-o", p(&d.join("m.yaml"))]);
+    assert_eq!(o.status.code(), Some(1));
+    let e = text(&o.stderr);
+    assert!(e.contains("broken.yaml:2") && e.contains("resolution"), "{e}");
+    let o = mrslam(&["merge", p(&d.join("nope.yaml")), p(&d.join("a.yaml"))]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(text(&o.stderr).contains("nope.yaml"));
+}
