@@ -26,6 +26,8 @@ enum Command {
     /// Inspect CARMEN laser logs.
     #[command(subcommand)]
     Log(cmd::log::LogCommand),
+    /// Run a scenario end to end: simulate both robots, map, merge, evaluate against truth.
+    Run(cmd::run::RunArgs),
     /// Map a CARMEN log with GMapping-style particle filter SLAM.
     Slam(cmd::slam::SlamArgs),
 }
@@ -37,6 +39,7 @@ fn main() -> ExitCode {
         Command::Log(c) => cmd::log::run(c),
         Command::Merge(a) => cmd::merge::run(a),
         Command::Slam(a) => cmd::slam::run(a),
+        Command::Run(a) => cmd::run::run(a),
     };
     match result {
         Ok(code) => code,

@@ -6,8 +6,8 @@ use mrslam_core::OccupancyGrid;
 use mrslam_core::map_io::{self, write_file_atomic};
 use mrslam_merge::map_image::MapImage;
 use mrslam_merge::{
-    Evidence, FusionRule, MapEncoding, MatchParams, MergeParams, MergeReport, Merger, Model, SiftMerger,
-    SiftMergerParams, merge,
+    Evidence, FusionRule, MapEncoding, MatchParams, MergeParams, MergeReport, Merger, Model, RmapMerger, RmapParams,
+    SiftMerger, SiftMergerParams, merge,
 };
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -25,8 +25,8 @@ pub struct MergeArgs {
     /// Write the merge report (JSON) here, accepted or not.
     #[arg(long)]
     pub report: Option<PathBuf>,
-    /// Merge algorithm.
-    #[arg(long, default_value = "sift", value_parser = ["sift"])]
+    /// Merge algorithm: `sift` (the paper's, Alg. 3) or `rmap` (Park's R-map baseline, Alg. 1).
+    #[arg(long, default_value = "sift", value_parser = ["sift", "rmap"])]
     pub algorithm: String,
     /// Transform model: rigid, similarity or homography (the paper's; its rigid part is used).
     #[arg(long, default_value = "rigid")]
@@ -67,6 +67,11 @@ pub fn run(args: MergeArgs) -> Result<ExitCode> {
     params.ransac.seed = args.seed;
     let merger: Box<dyn Merger> = match args.algorithm.as_str() {
         "sift" => Box::new(SiftMerger::new(params)),
+        "rmap" => {
+            let mut rp = RmapParams::default();
+            rp.orient.seed = args.seed;
+            Box::new(RmapMerger::new(rp))
+        }
         other => bail!("unknown algorithm `{other}`"),
     };
     let mp = MergeParams { verify_enabled: !args.no_verify, fusion: args.fusion, ..MergeParams::default() };

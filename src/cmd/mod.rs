@@ -3,4 +3,5 @@
 pub mod log;
 pub mod map;
 pub mod merge;
+pub mod run;
 pub mod slam;

@@ -1,0 +1,64 @@
+//! `mrslam run`, as a user would: bad scenarios are refused with the file, line and field named.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn mrslam(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_mrslam")).args(args).output().expect("mrslam runs")
+}
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// The two-rooms scenario with one line replaced, written next to the shipped one's world path.
+fn variant(dir: &Path, name: &str, from: &str, to: &str) -> PathBuf {
+    let text = std::fs::read_to_string(root().join("scenarios/paper_two_rooms.toml")).unwrap();
+    assert!(text.contains(from), "the shipped scenario no longer contains `{from}`");
+    let world = root().join("worlds/two_rooms.toml");
+    let text =
+        text.replace(from, to).replace("\"../worlds/two_rooms.toml\"", &format!("{:?}", world.display().to_string()));
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+fn assert_refused(path: &Path, needles: &[&str]) {
+    let o = mrslam(&["run", path.to_str().unwrap(), "--quiet", "--out", path.with_extension("out").to_str().unwrap()]);
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{e}");
+    assert!(!e.contains("panicked"), "{e}");
+    for n in needles {
+        assert!(e.contains(n), "stderr lacks `{n}`: {e}");
+    }
+}
+
+#[test]
+fn bad_scenarios_name_file_line_and_field() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let p = variant(d, "world.toml", "world = \"../worlds/two_rooms.toml\"", "world = \"nowhere.toml\"");
+    assert_refused(&p, &["world.toml:", "world", "nowhere.toml"]);
+    let p = variant(d, "lidar.toml", "lidar = \"rplidar_a1\"", "lidar = \"velodyne\"");
+    assert_refused(&p, &["lidar.toml:", "robots[1].lidar", "unknown lidar preset `velodyne`"]);
+    let p = variant(d, "start.toml", "start = \"start_prawn\"", "start = [5.6, 3.0, 0.0]");
+    assert_refused(&p, &["start.toml:", "robots[1].start", "inside an obstacle"]);
+    let p = variant(d, "waypoint.toml", "[8.7, 3.5]", "[80.7, 3.5]");
+    assert_refused(&p, &["waypoint.toml:", "robots[1].route[0]", "outside the world"]);
+    let p = variant(d, "late.toml", "when = \"rendezvous\"", "when = 500.0");
+    assert_refused(&p, &["late.toml:", "merge.when", "after the end"]);
+    let p = variant(d, "key.toml", "speed = 0.3\n", "speed = 0.3\nturbo = true\n");
+    assert_refused(&p, &["key.toml:", "unknown field `turbo`"]);
+    let p = variant(d, "model.toml", "model = \"prawn\"", "model = \"roomba\"");
+    assert_refused(&p, &["model.toml:", "robots[1].model", "roomba"]);
+}
+
+#[test]
+fn unknown_algorithm_and_missing_file_are_refused() {
+    let o = mrslam(&["run", root().join("scenarios/paper_two_rooms.toml").to_str().unwrap(), "--algorithm", "magic"]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("--algorithm magic"));
+    let o = mrslam(&["run", "no/such/scenario.toml"]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("no/such/scenario.toml"));
+}
