@@ -21,6 +21,8 @@ enum Command {
     /// Inspect and convert ROS map_server maps.
     #[command(subcommand)]
     Map(cmd::map::MapCommand),
+    /// Detect SIFT keypoints in an image or a map; print, save as JSON, draw.
+    Features(cmd::features::FeaturesArgs),
     /// Merge two maps of unknown relative pose (exit 2 when no reliable transform is found).
     Merge(cmd::merge::MergeArgs),
     /// Inspect CARMEN laser logs.
@@ -38,6 +40,7 @@ fn main() -> ExitCode {
         Command::Map(c) => cmd::map::run(c),
         Command::Log(c) => cmd::log::run(c),
         Command::Merge(a) => cmd::merge::run(a),
+        Command::Features(a) => cmd::features::run(a),
         Command::Slam(a) => cmd::slam::run(a),
         Command::Run(a) => cmd::run::run(a),
     };

@@ -1,5 +1,6 @@
 //! One module per subcommand.
 
+pub mod features;
 pub mod log;
 pub mod map;
 pub mod merge;
