@@ -122,3 +122,38 @@ fn unreadable_map_exits_1_naming_it() {
     assert_eq!(o.status.code(), Some(1));
     assert!(text(&o.stderr).contains("nope.yaml"));
 }
+
+#[test]
+fn rmap_algorithm_writes_the_same_report() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    write_ros_map(&generate(25, &FloorplanParams::default()), &d.join("plan.yaml")).unwrap();
+    let o = mrslam(&[
+        "map",
+        "cut",
+        p(&d.join("plan.yaml")),
+        p(&d.join("a.yaml")),
+        p(&d.join("b.yaml")),
+        "--overlap",
+        "0.6",
+    ]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let (a, b) = (d.join("a.yaml"), d.join("b.yaml"));
+    for verify in [true, false] {
+        let mut args = vec!["merge", p(&a), p(&b), "--algorithm", "rmap", "--report"];
+        let report = d.join(format!("rmap_{verify}.json"));
+        args.push(p(&report));
+        if !verify {
+            args.push("--no-verify");
+        }
+        let o = mrslam(&args);
+        // Accepted (0) or rejected (2): both are answers; anything else is a failure.
+        assert!(matches!(o.status.code(), Some(0) | Some(2)), "{}", text(&o.stderr));
+        let r: serde_json::Value = serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();
+        assert_eq!(r["algorithm"], "rmap");
+        assert!(r["time_ms"].as_f64().unwrap() > 0.0);
+        if !verify && r["transform"].is_object() {
+            assert_eq!(r["accepted"], true, "--no-verify accepts whatever the algorithm answers");
+        }
+    }
+}

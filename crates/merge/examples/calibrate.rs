@@ -1,6 +1,8 @@
 //! Measures what the merger's defaults rest on: success and false-merge rates of both map encodings on
 //! generated floor-plan pairs, with the verification statistics of correct and wrong answers.
 //!
+//! Variants: `walls` and `paper` encodings with OpenCV's doubled image, and `walls-1x` without doubling.
+//!
 //! `cargo run --release -p mrslam-merge --example calibrate -- [PAIRS]`
 
 use mrslam_merge::floorplan::{FloorplanParams, generate};
@@ -10,8 +12,15 @@ use mrslam_merge::{MapEncoding, MergeParams, SiftMerger, SiftMergerParams, merge
 fn main() {
     let n: u64 = std::env::args().nth(1).and_then(|s| s.parse().ok()).unwrap_or(40);
     let raw = MergeParams { verify_enabled: false, ..MergeParams::default() };
-    for (name, enc) in [("walls", MapEncoding::WALLS), ("paper", MapEncoding::PAPER)] {
-        let merger = SiftMerger::new(SiftMergerParams { encoding: enc, ..Default::default() });
+    let variants = [
+        ("walls", MapEncoding::WALLS, true),
+        ("paper", MapEncoding::PAPER, true),
+        ("walls-1x", MapEncoding::WALLS, false),
+    ];
+    for (name, enc, upscale) in variants {
+        let mut params = SiftMergerParams { encoding: enc, ..Default::default() };
+        params.sift.upscale = upscale;
+        let merger = SiftMerger::new(params);
         for overlap in [-0.1, 0.1, 0.2, 0.3, 0.5] {
             let (mut correct, mut accepted_ok, mut accepted_wrong) = (0, 0, 0);
             let mut stats_wrong: Vec<(usize, usize, f64, usize, f64)> = Vec::new();

@@ -65,13 +65,18 @@ mod tests {
         b.set(0, 5, 2.0); // lands on a's (5, 5) when b is shifted by 0.5 m
         b.set(9, 9, -2.0);
         let t = pose(0.5, 0.0, 0.0);
+        let at = |g: &OccupancyGrid, x: f64, y: f64| {
+            let c = g.world_to_cell(&nalgebra::Point2::new(x, y)).expect("on the fused grid");
+            g.state(c.0, c.1)
+        };
         let sum = fuse(&a, &b, &t, FusionRule::LogOddsSum);
-        assert_eq!((sum.width(), sum.height()), (15, 10));
-        assert_eq!(sum.get(5, 5), 0.0);
-        assert_eq!(sum.state(14, 9), CellState::Free);
+        // the fused grid spans the known cells of both: x 0.5..1.5 m, y 0.5..1.0 m
+        assert_eq!((sum.width(), sum.height()), (10, 5));
+        assert_eq!(at(&sum, 0.55, 0.55), CellState::Unknown, "-2 + 2 = 0");
+        assert_eq!(at(&sum, 1.45, 0.95), CellState::Free);
         let ofu = fuse(&a, &b, &t, FusionRule::OccupiedFreeUnknown);
-        assert_eq!(ofu.state(5, 5), CellState::Occupied);
-        assert_eq!(ofu.state(14, 9), CellState::Free);
-        assert_eq!(ofu.state(0, 0), CellState::Unknown);
+        assert_eq!(at(&ofu, 0.55, 0.55), CellState::Occupied);
+        assert_eq!(at(&ofu, 1.45, 0.95), CellState::Free);
+        assert_eq!(at(&ofu, 0.95, 0.75), CellState::Unknown);
     }
 }

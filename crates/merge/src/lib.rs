@@ -1,6 +1,7 @@
 //! mrslam-merge: occupancy-grid map merging with unknown relative pose.
 //!
-//! The paper's SIFT merger ([`SiftMerger`], Algorithm 3) behind the [`Merger`] interface, a verification
+//! The paper's SIFT merger ([`SiftMerger`], Algorithm 3) and its R-map baseline ([`RmapMerger`], Algorithm 1)
+//! behind the [`Merger`] interface, a verification
 //! gate that rejects merges the maps themselves contradict ([`verify`]), fusion into one grid ([`fuse`]),
 //! and the generators evaluation needs: procedural floor plans ([`floorplan`]) and map pairs cut with a
 //! known overlap and a known transform ([`pairs`]).
@@ -14,6 +15,7 @@ pub mod merger;
 pub mod pairs;
 pub mod report;
 pub mod resample;
+pub mod rmap;
 pub mod sift_merger;
 pub mod verify;
 
@@ -23,5 +25,6 @@ pub use map_image::MapEncoding;
 pub use matching::MatchParams;
 pub use merger::{Alignment, Evidence, MergeOutcome, MergeParams, Merger, NoAlignment, merge};
 pub use report::{MergeReport, TransformXyt};
+pub use rmap::{RmapMerger, RmapParams};
 pub use sift_merger::{SiftMerger, SiftMergerParams};
 pub use verify::VerifyParams;

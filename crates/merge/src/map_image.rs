@@ -60,6 +60,13 @@ pub struct MapImage {
 impl MapImage {
     /// Renders the grid's known part plus `pad` cells of margin (the whole grid when nothing is known).
     pub fn render(grid: &OccupancyGrid, enc: &MapEncoding, pad: usize) -> MapImage {
+        Self::render_dilated(grid, enc, pad, 0)
+    }
+
+    /// Like [`MapImage::render`], with occupied cells grown by `dilation` cells (a square neighbourhood).
+    ///
+    /// SLAM maps draw walls one cell thick and broken; grown walls give SIFT steadier corners.
+    pub fn render_dilated(grid: &OccupancyGrid, enc: &MapEncoding, pad: usize, dilation: usize) -> MapImage {
         let (x0, y0, x1, y1) = match grid.known_bounds() {
             Some((a, b, c, d)) => (
                 a.saturating_sub(pad),
@@ -82,6 +89,9 @@ impl MapImage {
                 *p = enc.level(CellState::from_log_odds(l));
             }
         }
+        if dilation > 0 {
+            dilate_level(&mut pixels, w, h, enc.occupied, dilation);
+        }
         MapImage { width: w, height: h, pixels, x0, y0 }
     }
 
@@ -101,10 +111,41 @@ impl MapImage {
     }
 }
 
+/// Grows the pixels at grey level `level` by `r` pixels (separable square dilation).
+fn dilate_level(pixels: &mut [f32], w: usize, h: usize, level: f32, r: usize) {
+    let mask: Vec<bool> = pixels.iter().map(|&p| p == level).collect();
+    let mut rows = vec![false; w * h];
+    for y in 0..h {
+        for x in 0..w {
+            let (a, b) = (x.saturating_sub(r), (x + r).min(w - 1));
+            rows[y * w + x] = mask[y * w + a..=y * w + b].iter().any(|&m| m);
+        }
+    }
+    for y in 0..h {
+        let (a, b) = (y.saturating_sub(r), (y + r).min(h - 1));
+        for x in 0..w {
+            if (a..=b).any(|yy| rows[yy * w + x]) {
+                pixels[y * w + x] = level;
+            }
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use mrslam_core::pose;
+
+    #[test]
+    fn dilation_grows_walls_by_the_radius() {
+        let mut g = OccupancyGrid::new(9, 9, 0.1, pose(0.0, 0.0, 0.0)).unwrap();
+        g.cells_mut().fill(-2.0);
+        g.set(4, 4, 2.0);
+        let img = MapImage::render_dilated(&g, &MapEncoding::WALLS, 0, 1);
+        let dark = img.pixels.iter().filter(|&&p| p == 0.0).count();
+        assert_eq!(dark, 9, "a single wall cell grows into a 3x3 block");
+        assert_eq!(MapImage::render(&g, &MapEncoding::WALLS, 0).pixels.iter().filter(|&&p| p == 0.0).count(), 1);
+    }
 
     #[test]
     fn pixel_and_map_coordinates_invert() {

@@ -39,6 +39,21 @@ impl Default for PairSpec {
 /// Cuts `map` along a random direction into two halves with the given overlap, then rotates and shifts the
 /// second half at random. Deterministic in `seed`.
 pub fn cut_pair(map: &OccupancyGrid, spec: &PairSpec, seed: u64) -> MapPair {
+    cut_pair_with(map, spec, seed, |rng| rng.random_range(-std::f64::consts::PI..std::f64::consts::PI))
+}
+
+/// As [`cut_pair`], but the second half turns by a random multiple of 90° (when `spec.rotate`), so an
+/// axis-aligned map stays axis-aligned.
+pub fn cut_pair_quarter(map: &OccupancyGrid, spec: &PairSpec, seed: u64) -> MapPair {
+    cut_pair_with(map, spec, seed, |rng| rng.random_range(0..4u8) as f64 * std::f64::consts::FRAC_PI_2)
+}
+
+fn cut_pair_with(
+    map: &OccupancyGrid,
+    spec: &PairSpec,
+    seed: u64,
+    draw_angle: impl FnOnce(&mut ChaCha8Rng) -> f64,
+) -> MapPair {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let dir = rng.random_range(-std::f64::consts::PI..std::f64::consts::PI);
     let (dx, dy) = (dir.cos(), dir.sin());
@@ -76,7 +91,7 @@ pub fn cut_pair(map: &OccupancyGrid, spec: &PairSpec, seed: u64) -> MapPair {
     };
     let a = keep(&in_a);
     let b_cut = keep(&in_b);
-    let theta = if spec.rotate { rng.random_range(-std::f64::consts::PI..std::f64::consts::PI) } else { 0.0 };
+    let theta = if spec.rotate { draw_angle(&mut rng) } else { 0.0 };
     let t_b_a = pose(
         rng.random_range(-spec.max_shift_m..=spec.max_shift_m),
         rng.random_range(-spec.max_shift_m..=spec.max_shift_m),
@@ -102,6 +117,18 @@ mod tests {
             // nearest-neighbour rotation of thin walls costs a little agreement, not much
             assert!(agr.acceptance_index() > 0.97, "{agr:?}");
             assert!(agr.common() > 1000);
+        }
+    }
+
+    #[test]
+    fn quarter_pairs_turn_by_quarter_turns_and_align() {
+        let map = generate(3, &FloorplanParams::default());
+        let spec = PairSpec { overlap: 0.6, ..Default::default() };
+        for seed in 0..4 {
+            let pair = cut_pair_quarter(&map, &spec, seed);
+            let q = pair.t_a_b.rotation.angle() / std::f64::consts::FRAC_PI_2;
+            assert!((q - q.round()).abs() < 1e-9, "{q}");
+            assert!(agreement(&pair.a, &pair.b, &pair.t_a_b).acceptance_index() > 0.99);
         }
     }
 

@@ -27,6 +27,8 @@ pub struct SiftMergerParams {
     pub ransac: RansacParams,
     /// Unknown margin kept around each map's known part when it becomes an image, cells.
     pub image_padding: usize,
+    /// Occupied cells are grown by this many cells before SIFT (0 = the map as it is, as the paper does).
+    pub wall_dilation: usize,
     /// Detect features of the two maps on two threads.
     pub parallel: bool,
 }
@@ -40,6 +42,7 @@ impl Default for SiftMergerParams {
             model: Model::Rigid,
             ransac: RansacParams::default(),
             image_padding: 8,
+            wall_dilation: 0,
             parallel: false,
         }
     }
@@ -81,7 +84,7 @@ fn detect(img: &GrayImage, params: &SiftParams) -> Features {
 
 /// Features of one map with their map-frame positions.
 fn map_features(grid: &OccupancyGrid, p: &SiftMergerParams) -> (Features, Vec<Point2<f64>>) {
-    let img = MapImage::render(grid, &p.encoding, p.image_padding);
+    let img = MapImage::render_dilated(grid, &p.encoding, p.image_padding, p.wall_dilation);
     let features = match GrayImage::new(img.width, img.height, img.pixels) {
         Ok(g) => detect(&g, &p.sift),
         Err(_) => Features::default(), // only an empty image can fail here: no features

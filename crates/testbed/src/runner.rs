@@ -6,7 +6,10 @@ use crate::report::{MergeResult, RobotReport, RunReport};
 use crate::scenario::{ControllerKind, MergeWhen, RobotSetup, Scenario};
 use mrslam_core::map_io::{self, MapIoError};
 use mrslam_core::{CellTraversal, LaserScan, OccupancyGrid, Odometry, Pose2};
-use mrslam_merge::{MatchParams, MergeOutcome, MergeParams, Merger, SiftMerger, SiftMergerParams, TransformXyt, merge};
+use mrslam_merge::{
+    MatchParams, MergeOutcome, MergeParams, Merger, RmapMerger, RmapParams, SiftMerger, SiftMergerParams, TransformXyt,
+    merge,
+};
 use mrslam_sim::{RobotId, Sim, SimConfig, SimError};
 use mrslam_slam::{Rbpf, SlamError};
 use nalgebra::Point2;
@@ -70,6 +73,11 @@ pub fn merger_for(name: &str, scenario: &Scenario) -> Result<Box<dyn Merger>, Ru
             };
             p.ransac.seed = scenario.seed;
             Ok(Box::new(SiftMerger::new(p)))
+        }
+        "rmap" => {
+            let mut p = RmapParams::default();
+            p.orient.seed = scenario.seed;
+            Ok(Box::new(RmapMerger::new(p)))
         }
         other => Err(RunError::UnknownAlgorithm(other.to_string())),
     }

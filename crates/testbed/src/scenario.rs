@@ -262,7 +262,7 @@ struct SuccessFile {
 }
 
 /// Merge algorithms a scenario may name.
-pub const ALGORITHMS: &[&str] = &["sift"];
+pub const ALGORITHMS: &[&str] = &["sift", "rmap"];
 
 /// The 1-based line of the first line of `text` containing `needle` (0 when absent).
 fn line_of(text: &str, needle: &str) -> usize {
@@ -583,7 +583,7 @@ fn resolve_merge(cx: &Ctx, m: &MergeFile, robots: &[RobotSetup], duration: f64) 
         }
     };
     if let MergeWhen::At(t) = when {
-        if !(t > 0.0) {
+        if t.is_nan() || t <= 0.0 {
             return Err(cx.err("merge.when", "when", format!("merge time must be positive, got {t}")));
         }
         if t > duration {
