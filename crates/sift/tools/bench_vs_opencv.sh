@@ -6,12 +6,12 @@ set -euo pipefail
 rounds="${1:-4}"; runs="${2:-7}"
 here="$(cd "$(dirname "$0")" && pwd)"
 root="$(cd "$here/../../.." && pwd)"
-export CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-/work/target-sift}"
+export CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-$root/target}"
 dir="$(mktemp -d)"
 (cd "$root" && cargo build -q -p mrslam-sift --release --examples)
 "$CARGO_TARGET_DIR/release/examples/gen_images" "$dir" > /dev/null
 tool="$root/../shared/tools/opencv_sift.py"
-[ -f "$tool" ] || tool=/work/shared/tools/opencv_sift.py
+[ -f "$tool" ] || { echo "opencv_sift.py not found beside the repository (../shared/tools)" >&2; exit 1; }
 for img in map_1024 texture_1024; do
   ours=(); cv=()
   for _ in $(seq "$rounds"); do
