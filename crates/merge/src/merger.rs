@@ -2,7 +2,7 @@
 
 use crate::fuse::{FusionRule, fuse};
 use crate::report::{MergeReport, TransformXyt};
-use crate::verify::{Agreement, VerifyParams, agreement, confidence, rejection_reason};
+use crate::verify::{Agreement, VerifyParams, agreement, ambiguity, confidence, rejection_reason};
 use mrslam_core::{OccupancyGrid, Pose2};
 use nalgebra::Point2;
 use std::collections::BTreeMap;
@@ -106,6 +106,7 @@ pub fn merge(merger: &dyn Merger, a: &OccupancyGrid, b: &OccupancyGrid, p: &Merg
                 acceptance_index: None,
                 common_cells: 0,
                 wall_agreement: None,
+                ambiguity: None,
                 reason: Some(no.reason),
                 time_ms: ms(start),
                 timings_ms: no.timings_ms,
@@ -118,8 +119,24 @@ pub fn merge(merger: &dyn Merger, a: &OccupancyGrid, b: &OccupancyGrid, p: &Merg
     let agr: Agreement = agreement(a, b, &alignment.transform);
     timings.insert("verify".into(), ms(t));
     let conf = confidence(alignment.inliers, alignment.matches);
-    let reason =
+    let mut reason =
         if p.verify_enabled { rejection_reason(&p.verify, alignment.inliers, alignment.matches, &agr) } else { None };
+    let mut ambiguous = None;
+    if reason.is_none() && p.verify_enabled {
+        let t = Instant::now();
+        let amb = ambiguity(a, b, &alignment.transform, p.verify.ambiguity_shift_m);
+        timings.insert("ambiguity".into(), ms(t));
+        ambiguous = Some(amb);
+        if amb >= p.verify.max_ambiguity {
+            reason = Some(format!(
+                "ambiguous: slid {} m, b still meets {:.0}% of the walls it meets in place (limit {:.0}%); \
+                 the maps do not pin the transform down",
+                p.verify.ambiguity_shift_m,
+                100.0 * amb,
+                100.0 * p.verify.max_ambiguity
+            ));
+        }
+    }
     let merged = reason.is_none().then(|| {
         let t = Instant::now();
         let g = fuse(a, b, &alignment.transform, p.fusion);
@@ -137,6 +154,7 @@ pub fn merge(merger: &dyn Merger, a: &OccupancyGrid, b: &OccupancyGrid, p: &Merg
         acceptance_index: Some(agr.acceptance_index()),
         common_cells: agr.common(),
         wall_agreement: Some(agr.wall_agreement()),
+        ambiguity: ambiguous,
         reason,
         time_ms: ms(start),
         timings_ms: timings,

@@ -49,6 +49,9 @@ pub struct MergeReport {
     pub common_cells: usize,
     /// Share of b's walls meeting a wall of a after alignment.
     pub wall_agreement: Option<f64>,
+    /// Best share of those wall matches kept when b slides 1 m (near 1: not pinned down); computed only when
+    /// every other check passed.
+    pub ambiguity: Option<f64>,
     /// Why the merge was rejected.
     pub reason: Option<String>,
     /// Wall time of the merge itself (file loading excluded), milliseconds.

@@ -7,6 +7,7 @@
 
 use crate::resample::{GridGeometry, sample_cells};
 use mrslam_core::{CellState, OccupancyGrid, Pose2};
+use nalgebra::{Point2, Translation2};
 
 /// Thresholds a merge must pass to be accepted.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -21,6 +22,11 @@ pub struct VerifyParams {
     pub min_common_cells: usize,
     /// Lowest share of b's walls meeting a's walls ([`Agreement::wall_agreement`]).
     pub min_wall_agreement: f64,
+    /// Reject when b slid by [`VerifyParams::ambiguity_shift_m`] in some direction keeps this share (or more) of
+    /// the walls it matched in place: the maps then do not pin the transform down (a corridor's length).
+    pub max_ambiguity: f64,
+    /// Slide used by the ambiguity check, metres.
+    pub ambiguity_shift_m: f64,
 }
 
 impl Default for VerifyParams {
@@ -32,6 +38,8 @@ impl Default for VerifyParams {
             min_acceptance: 0.9,
             min_common_cells: 200,
             min_wall_agreement: 0.6,
+            max_ambiguity: 0.85,
+            ambiguity_shift_m: 1.0,
         }
     }
 }
@@ -98,6 +106,50 @@ pub fn agreement(a: &OccupancyGrid, b: &OccupancyGrid, t_a_b: &Pose2) -> Agreeme
     r
 }
 
+/// Walls of `b` (occupied cell centres, b's frame) placed by `t_a_b`: how many land on a's known cells, and
+/// how many of those have an occupied cell of `a` within one cell.
+pub fn wall_hits(a: &OccupancyGrid, walls_b: &[Point2<f64>], t_a_b: &Pose2) -> (usize, usize) {
+    let (mut on_known, mut matched) = (0, 0);
+    for p in walls_b {
+        let (ix, iy) = a.world_to_cell_i(&(t_a_b * p));
+        let Some(l) = a.get_checked(ix, iy) else { continue };
+        if CellState::from_log_odds(l) == CellState::Unknown {
+            continue;
+        }
+        on_known += 1;
+        let near = (-1..=1).any(|dy| {
+            (-1..=1).any(|dx| {
+                a.get_checked(ix + dx, iy + dy).is_some_and(|l| CellState::from_log_odds(l) == CellState::Occupied)
+            })
+        });
+        matched += near as usize;
+    }
+    (on_known, matched)
+}
+
+/// How well the maps still agree when b slides `shift` metres (8 directions, in b's frame) away from `t_a_b`:
+/// the largest count of b's walls meeting a's walls over the slides, as a share of the count in place.
+///
+/// Near 1 means the alignment is not pinned down along some direction, as in a featureless corridor.
+pub fn ambiguity(a: &OccupancyGrid, b: &OccupancyGrid, t_a_b: &Pose2, shift: f64) -> f64 {
+    let walls_b: Vec<Point2<f64>> = (0..b.height())
+        .flat_map(|iy| (0..b.width()).map(move |ix| (ix, iy)))
+        .filter(|&(ix, iy)| b.state(ix, iy) == CellState::Occupied)
+        .map(|(ix, iy)| b.cell_center(ix as i64, iy as i64))
+        .collect();
+    let (_, here) = wall_hits(a, &walls_b, t_a_b);
+    if here == 0 {
+        return 1.0;
+    }
+    (0..8)
+        .map(|k| {
+            let ang = k as f64 * std::f64::consts::FRAC_PI_4;
+            let slid = t_a_b * Translation2::new(shift * ang.cos(), shift * ang.sin());
+            wall_hits(a, &walls_b, &slid).1 as f64 / here as f64
+        })
+        .fold(0.0, f64::max)
+}
+
 /// m-explore's match confidence.
 pub fn confidence(inliers: usize, matches: usize) -> f64 {
     inliers as f64 / (8.0 + 0.3 * matches as f64)
@@ -153,6 +205,24 @@ mod tests {
         assert_eq!(shifted.wall_agreement(), 0.0);
         // one cell off still counts as meeting the wall
         assert_eq!(agreement(&g, &g, &pose(0.1, 0.0, 0.0)).wall_agreement(), 1.0);
+    }
+
+    #[test]
+    fn a_corridor_slides_ambiguously_a_room_does_not() {
+        // A 10 m corridor (two long walls) and a closed 3 m room, both at 0.1 m.
+        let mut corridor = OccupancyGrid::new(100, 30, 0.1, pose(0.0, 0.0, 0.0)).unwrap();
+        let mut room = OccupancyGrid::new(30, 30, 0.1, pose(0.0, 0.0, 0.0)).unwrap();
+        for (g, closed) in [(&mut corridor, false), (&mut room, true)] {
+            let (w, h) = (g.width(), g.height());
+            for iy in 0..h {
+                for ix in 0..w {
+                    let wall = iy == 0 || iy == h - 1 || (closed && (ix == 0 || ix == w - 1));
+                    g.set(ix, iy, if wall { 2.0 } else { -2.0 });
+                }
+            }
+        }
+        assert!(ambiguity(&corridor, &corridor, &Pose2::identity(), 1.0) > 0.85);
+        assert!(ambiguity(&room, &room, &Pose2::identity(), 1.0) < 0.6);
     }
 
     #[test]

@@ -19,6 +19,7 @@ fn main() {
         lstep: 0.05,
         astep: 0.05,
         iterations: 5,
+        unknown_score: None,
     };
     // map from the first 150 true scans
     let mut tm = TileMap::new(0.05);

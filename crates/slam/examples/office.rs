@@ -1,74 +1,114 @@
-//! Runs the filter on the synthetic office loop and prints per-update errors (a development aid).
+//! Accuracy and speed harness on the synthetic runs of the crate's tests:
+//! `cargo run --release -p mrslam-slam --example office -- [hokuyo|rplidar|corridor] [name=value ...]`.
 
-use mrslam_core::pose;
-use mrslam_core::pose::{pose_xyt, relative};
-use mrslam_slam::synthetic::{self, Drift, Lidar};
-use mrslam_slam::{Rbpf, SlamParams, UpdateOutcome};
+use mrslam_core::pose::relative;
+use mrslam_core::{CellState, OccupancyGrid, Pose2, pose};
+use mrslam_slam::synthetic::{self, Drift, Lidar, SyntheticRun};
+use mrslam_slam::{Rbpf, SlamParams};
 
-fn main() {
-    let args: Vec<String> = std::env::args().collect();
-    let seed: u64 = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(11);
-    let rp = std::env::var("RP").is_ok();
-    let lidar = if rp { Lidar::rplidar() } else { Lidar::hokuyo() };
-    let map = synthetic::office_map();
-    let path = synthetic::waypoint_path(&synthetic::office_loop(), 0.05, 0.1);
-    let envd = |k: &str, d: f64| std::env::var(k).ok().and_then(|v| v.parse().ok()).unwrap_or(d);
-    let drift = Drift { scale: envd("DS", 0.03), heading_per_m: envd("DH", 0.01), sigma_trans: 0.02, sigma_rot: 0.01 };
-    let run = synthetic::simulate(&map, &path, 0.1, &lidar, pose(0.1, 0.0, 0.0), &drift, seed);
-    let env = |k: &str, d: f64| std::env::var(k).ok().and_then(|v| v.parse().ok()).unwrap_or(d);
-    let base = if rp { SlamParams::rplidar() } else { SlamParams::hokuyo() };
-    let params = SlamParams {
-        sigma: env("SIGMA", base.sigma),
-        lsigma: env("LSIGMA", base.lsigma),
-        lskip: env("LSKIP", base.lskip as f64) as usize,
-        linear_update: env("LU", base.linear_update),
-        particles: env("N", base.particles as f64) as usize,
-        kernel_size: env("KS", base.kernel_size as f64) as i32,
-        ogain: env("OGAIN", base.ogain),
-        ..base
-    };
-    let mut f = Rbpf::new(params, run.laser_offset, 5).unwrap();
-    let t0 = run.truth[0].1;
-    let start = std::time::Instant::now();
-    let mut sum = 0.0;
-    let mut n = 0;
-    for (k, (o, s)) in run.odometry.iter().zip(&run.scans).enumerate() {
-        let t = std::time::Instant::now();
-        let out = f.process(o, s).unwrap();
-        if let UpdateOutcome::Processed(st) = out {
-            let truth = relative(&t0, &run.truth[k].1);
-            let est = f.best_pose();
-            let (ex, ey, et) = pose_xyt(&relative(&truth, &est));
-            sum += ex * ex + ey * ey;
-            n += 1;
-            if std::env::var("V").is_ok() && (n % 10 == 0 || ex.hypot(ey) > 0.1) {
-                println!(
-                    "{k:5} err ({ex:+.3},{ey:+.3},{et:+.4}) neff {:5.1} res {} score {:6.1}/{} ms {:.1}",
-                    st.neff,
-                    st.resampled as u8,
-                    st.mean_score,
-                    st.beams_matched,
-                    t.elapsed().as_secs_f64() * 1e3
-                );
+fn acceptance(map: &OccupancyGrid, truth: &OccupancyGrid, t0: &Pose2) -> f64 {
+    let (mut a, mut d) = (0usize, 0usize);
+    for iy in 0..map.height() {
+        for ix in 0..map.width() {
+            let s = map.state(ix, iy);
+            if s == CellState::Unknown {
+                continue;
+            }
+            let p = t0 * map.cell_center(ix as i64, iy as i64);
+            let Some((tx, ty)) = truth.world_to_cell(&p) else { continue };
+            match truth.state(tx, ty) {
+                CellState::Unknown => {}
+                t if t == s => a += 1,
+                _ => d += 1,
             }
         }
     }
-    println!("online rms {:.4}, {:.2} s, {:?}", (sum / n as f64).sqrt(), start.elapsed().as_secs_f64(), f.counters());
-    println!("{:?}", f.memory_stats());
-    let traj = f.trajectory();
-    let mut s2 = 0.0;
-    for (st, p) in &traj {
-        let k = run.truth.iter().position(|(s, _)| s == st).unwrap();
-        let t = relative(&t0, &run.truth[k].1);
-        s2 += (p.translation.vector - t.translation.vector).norm_squared();
+    a as f64 / (a + d).max(1) as f64
+}
+
+fn errors(est: &[(f64, Pose2)], truth: &[(f64, Pose2)]) -> (f64, f64) {
+    let t0 = truth[0].1;
+    let (mut sum, mut max) = (0.0, 0.0f64);
+    for (stamp, p) in est {
+        let k = truth.binary_search_by(|(s, _)| s.total_cmp(stamp)).unwrap();
+        let t = relative(&t0, &truth[k].1);
+        let d = (p.translation.vector - t.translation.vector).norm();
+        sum += d * d;
+        max = max.max(d);
     }
-    println!("final trajectory rms {:.4}", (s2 / traj.len() as f64).sqrt());
-    let mut o2 = 0.0;
-    for (st, _) in &traj {
-        let k = run.truth.iter().position(|(s, _)| s == st).unwrap();
-        let t = relative(&t0, &run.truth[k].1);
-        let o = relative(&run.odometry[0].pose, &run.odometry[k].pose);
-        o2 += (o.translation.vector - t.translation.vector).norm_squared();
+    ((sum / est.len() as f64).sqrt(), max)
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let which = args.first().map(String::as_str).unwrap_or("hokuyo");
+    let drift = Drift { scale: 0.03, heading_per_m: 0.01, sigma_trans: 0.02, sigma_rot: 0.01 };
+    let (run, mut params, seed): (SyntheticRun, SlamParams, u64) = match which {
+        "rplidar" => {
+            let path = synthetic::waypoint_path(&synthetic::office_loop(), 0.1, 0.2);
+            let m = synthetic::office_map();
+            (
+                synthetic::simulate(&m, &path, 0.2, &Lidar::rplidar(), pose(0.0, 0.0, 0.0), &drift, 3),
+                SlamParams::rplidar(),
+                9,
+            )
+        }
+        "corridor" => {
+            let m = synthetic::corridor_map(52.0);
+            let path = synthetic::waypoint_path(&[(1.0, 2.5), (51.0, 2.5)], 0.05, 0.1);
+            (
+                synthetic::simulate(&m, &path, 0.1, &Lidar::hokuyo(), pose(0.1, 0.0, 0.0), &drift, 1),
+                SlamParams::hokuyo(),
+                1,
+            )
+        }
+        _ => {
+            let path = synthetic::waypoint_path(&synthetic::office_loop(), 0.05, 0.1);
+            let m = synthetic::office_map();
+            (
+                synthetic::simulate(&m, &path, 0.1, &Lidar::hokuyo(), pose(0.1, 0.0, 0.0), &drift, 11),
+                SlamParams::hokuyo(),
+                5,
+            )
+        }
+    };
+    let mut seed = seed;
+    for a in args.iter().skip(1) {
+        let (k, v) = a.split_once('=').expect("name=value");
+        if k == "seed" {
+            seed = v.parse().unwrap();
+            continue;
+        }
+        params.set(k, v).unwrap();
     }
-    println!("odometry rms {:.4}", (o2 / traj.len() as f64).sqrt());
+    let mut f = Rbpf::new(params, run.laser_offset, seed).unwrap();
+    let t = std::time::Instant::now();
+    let mut times = Vec::new();
+    for (o, s) in run.odometry.iter().zip(&run.scans) {
+        let t1 = std::time::Instant::now();
+        if f.process(o, s).unwrap().is_processed() {
+            times.push(t1.elapsed().as_secs_f64() * 1e3);
+        }
+    }
+    let secs = t.elapsed().as_secs_f64();
+    times.sort_by(f64::total_cmp);
+    let (rms, max) = errors(&f.trajectory(), &run.truth);
+    if std::env::var("TRACE").is_ok() {
+        let t0 = run.truth[0].1;
+        for (i, (stamp, p)) in f.trajectory().iter().enumerate().step_by(5) {
+            let k = run.truth.binary_search_by(|(s, _)| s.total_cmp(stamp)).unwrap();
+            let t = relative(&t0, &run.truth[k].1);
+            let e = t.inverse() * p;
+            let (ex, ey, et) = mrslam_core::pose::pose_xyt(&e);
+            let (tx, ty, _) = mrslam_core::pose::pose_xyt(&run.truth[k].1);
+            println!("{i:4} truth ({tx:5.1},{ty:5.1}) err ({ex:+.3},{ey:+.3},{et:+.4})");
+        }
+    }
+    let ai = acceptance(&f.map().unwrap(), &run.truth_map, &run.truth[0].1);
+    println!(
+        "{which}: rms {rms:.4} max {max:.3} ai {ai:.4} | {} processed, {} resamples, {secs:.1} s, median update {:.1} ms",
+        f.counters().processed,
+        f.counters().resamples,
+        times[times.len() / 2]
+    );
 }

@@ -73,6 +73,18 @@ pub struct SlamParams {
     pub lasamplestep: f64,
     /// `occ_thresh`: a cell of the output map is occupied when hits/visits exceeds this (GMapping 0.25).
     pub occ_thresh: f64,
+    /// Not GMapping: match only the beams whose end point finds an occupied cell at the motion-model pose
+    /// (the "frontier guard"; see [`crate::scan_matcher::ScanMatcher::beams_in_map`]). Off by default.
+    pub frontier_guard: bool,
+    /// Not GMapping: metres of each beam before its end point, and as far behind it, marked as seen
+    /// ("known") in every particle's map; 0 (the default) keeps GMapping's hits-only matching.
+    /// When positive, a beam whose window finds no occupied cell and whose end point lies in never-seen
+    /// space scores `unknown_score` and costs no likelihood, instead of scoring 0 and costing
+    /// `nullLikelihood`: GMapping's score otherwise rewards poses that pull beams ending beyond the mapped
+    /// region back onto it, which drags the pose backwards whenever the robot drives into new space.
+    pub seen_band: f64,
+    /// Score of a beam ending in never-seen space when `seen_band` is on, as a fraction of a perfect match.
+    pub unknown_score: f64,
 }
 
 impl Default for SlamParams {
@@ -105,6 +117,9 @@ impl Default for SlamParams {
             lasamplerange: 0.005,
             lasamplestep: 0.005,
             occ_thresh: 0.25,
+            frontier_guard: false,
+            seen_band: 0.0,
+            unknown_score: 0.5,
         }
     }
 }
@@ -121,7 +136,9 @@ impl SlamParams {
             max_urange: 4.0,
             linear_update: 0.25,
             angular_update: 0.25,
-            lskip: 1,
+            lskip: 3,
+            sigma: 0.01,
+            seen_band: 0.6,
             ..SlamParams::default()
         }
     }
@@ -135,9 +152,49 @@ impl SlamParams {
             max_urange: 6.0,
             linear_update: 0.3,
             angular_update: 0.25,
-            lskip: 0,
+            lskip: 1,
+            sigma: 0.01,
+            seen_band: 0.6,
             ..SlamParams::default()
         }
+    }
+
+    /// Sets the parameter called `name` (the field's name) from its text `value`; for command lines and
+    /// scenario files. Errors name the parameter and what is wrong.
+    pub fn set(&mut self, name: &str, value: &str) -> Result<(), String> {
+        let f = || value.trim().parse::<f64>().map_err(|e| format!("{name}: {e} ('{value}')"));
+        let u = || value.trim().parse::<usize>().map_err(|e| format!("{name}: {e} ('{value}')"));
+        let b = || value.trim().parse::<bool>().map_err(|e| format!("{name}: {e} ('{value}')"));
+        match name {
+            "particles" => self.particles = u()?,
+            "delta" => self.delta = f()?,
+            "max_range" => self.max_range = f()?,
+            "max_urange" => self.max_urange = f()?,
+            "clear_max_range" => self.clear_max_range = b()?,
+            "linear_update" => self.linear_update = f()?,
+            "angular_update" => self.angular_update = f()?,
+            "temporal_update" => self.temporal_update = f()?,
+            "resample_threshold" => self.resample_threshold = f()?,
+            "sigma" => self.sigma = f()?,
+            "lsigma" => self.lsigma = f()?,
+            "ogain" => self.ogain = f()?,
+            "kernel_size" => self.kernel_size = value.trim().parse().map_err(|e| format!("{name}: {e}"))?,
+            "lstep" => self.lstep = f()?,
+            "astep" => self.astep = f()?,
+            "iterations" => self.iterations = value.trim().parse().map_err(|e| format!("{name}: {e}"))?,
+            "lskip" => self.lskip = u()?,
+            "minimum_score" => self.minimum_score = f()?,
+            "srr" => self.srr = f()?,
+            "srt" => self.srt = f()?,
+            "str" => self.str = f()?,
+            "stt" => self.stt = f()?,
+            "occ_thresh" => self.occ_thresh = f()?,
+            "frontier_guard" => self.frontier_guard = b()?,
+            "seen_band" => self.seen_band = f()?,
+            "unknown_score" => self.unknown_score = f()?,
+            _ => return Err(format!("unknown SLAM parameter '{name}'")),
+        }
+        Ok(())
     }
 
     /// Checks that every parameter is in its domain; returns a description of the first that is not.
@@ -185,6 +242,8 @@ impl SlamParams {
         for (n, v) in [("srr", self.srr), ("srt", self.srt), ("str", self.str), ("stt", self.stt)] {
             nonneg(n, v)?;
         }
+        nonneg("seen_band", self.seen_band)?;
+        nonneg("unknown_score", self.unknown_score)?;
         if !(self.occ_thresh.is_finite() && (0.0..1.0).contains(&self.occ_thresh)) {
             return Err(format!("occ_thresh must be in [0, 1), got {}", self.occ_thresh));
         }

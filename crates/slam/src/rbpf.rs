@@ -11,6 +11,7 @@ use mrslam_core::pose::{pose_xyt, relative};
 use mrslam_core::{LaserScan, OccupancyGrid, Odometry, Pose2, pose};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use rayon::prelude::*;
 use std::sync::Arc;
 
 /// Odometry farther than this from its frame's origin (metres) is refused as corrupt.
@@ -169,6 +170,7 @@ impl Rbpf {
             lstep: params.lstep,
             astep: params.astep,
             iterations: params.iterations,
+            unknown_score: (params.seen_band > 0.0).then_some(params.unknown_score),
         };
         let motion = MotionModel { srr: params.srr, srt: params.srt, str: params.str, stt: params.stt };
         let n = params.particles;
@@ -299,17 +301,34 @@ impl Rbpf {
         let mut neff = n as f64;
         if !first {
             let min_score = p.minimum_score;
-            for part in &mut self.particles {
-                let guarded = self.matcher.beams_in_map(&part.map, &part.pose, &prepared.matched);
-                let (corrected, score) = self.matcher.optimize(&part.map, &part.pose, &guarded);
+            let guard = p.frontier_guard;
+            let matcher = &self.matcher;
+            let beams = &prepared.matched;
+            // Each particle's match is independent of the others': computed in parallel, collected in order,
+            // so results do not depend on the number of threads.
+            let results: Vec<(Xyt, f64, f64)> = self
+                .particles
+                .par_iter()
+                .map(|part| {
+                    let (corrected, score) = if guard {
+                        let guarded = matcher.beams_in_map(&part.map, &part.pose, beams);
+                        matcher.optimize(&part.map, &part.pose, &guarded)
+                    } else {
+                        matcher.optimize(&part.map, &part.pose, beams)
+                    };
+                    let pose = if score > min_score { corrected } else { part.pose };
+                    let e = matcher.likelihood_and_score(&part.map, &pose, beams);
+                    (pose, score, e.likelihood)
+                })
+                .collect();
+            for (part, (pose, score, likelihood)) in self.particles.iter_mut().zip(results) {
                 if score > min_score {
-                    part.pose = corrected;
                     matched_particles += 1;
                 }
+                part.pose = pose;
                 score_sum += score;
-                let e = self.matcher.likelihood_and_score(&part.map, &part.pose, &prepared.matched);
-                part.weight += e.likelihood;
-                part.weight_sum += e.likelihood;
+                part.weight += likelihood;
+                part.weight_sum += likelihood;
             }
             let gain = 1.0 / (self.params.ogain * n as f64);
             let logw: Vec<f64> = self.particles.iter().map(|q| q.weight).collect();
@@ -336,17 +355,26 @@ impl Rbpf {
 
         // Map the scan in every particle and extend its trajectory.
         let shared_scan = Arc::new(scan.clone());
+        let band = self.params.seen_band;
+        let behind = band;
         for part in &mut self.particles {
             let lp = self.matcher.laser_pose(&part.pose);
             let (s, c) = lp.t.sin_cos();
+            let too_large = |part: &Particle| {
+                SlamError::MapTooLarge(format!(
+                    "a particle at ({:.1}, {:.1}) m left the largest map supported",
+                    part.pose.x, part.pose.y
+                ))
+            };
             for b in &prepared.hits {
                 let (dx, dy) = (c * b.c - s * b.s, s * b.c + c * b.s);
-                part.map.add_hit(lp.x + b.r * dx, lp.y + b.r * dy).map_err(|_| {
-                    SlamError::MapTooLarge(format!(
-                        "a particle at ({:.1}, {:.1}) m left the largest map supported",
-                        part.pose.x, part.pose.y
-                    ))
-                })?;
+                let (ex, ey) = (lp.x + b.r * dx, lp.y + b.r * dy);
+                if band > 0.0 {
+                    let r0 = (b.r - band).max(0.0);
+                    let (x0, y0) = (lp.x + r0 * dx, lp.y + r0 * dy);
+                    part.map.mark_seen(x0, y0, ex + behind * dx, ey + behind * dy).map_err(|_| too_large(part))?;
+                }
+                part.map.add_hit(ex, ey).map_err(|_| too_large(part))?;
             }
             part.node = Some(Arc::new(TrajectoryNode {
                 stamp: scan.stamp,

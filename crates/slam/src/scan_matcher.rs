@@ -96,6 +96,9 @@ pub struct ScanMatcher {
     pub astep: f64,
     /// Step halvings.
     pub iterations: u32,
+    /// Score of a beam ending unmatched in never-seen space; `None`: 0, as GMapping (see
+    /// [`crate::SlamParams::seen_band`]).
+    pub unknown_score: Option<f64>,
 }
 
 /// Result of evaluating a pose: score, log-likelihood and the number of beams that matched.
@@ -187,8 +190,14 @@ impl ScanMatcher {
         for b in beams {
             let dx = c * b.c - s * b.s;
             let dy = s * b.c + c * b.s;
-            if let Some(d2) = self.nearest(map, lp.x + b.r * dx, lp.y + b.r * dy, dx, dy) {
+            let (px, py) = (lp.x + b.r * dx, lp.y + b.r * dy);
+            if let Some(d2) = self.nearest(map, px, py, dx, dy) {
                 total += (-d2 * inv_sigma).exp();
+            } else if let Some(u) = self.unknown_score {
+                let (ix, iy) = map.cell_of(px, py);
+                if !map.seen(ix, iy) {
+                    total += u;
+                }
             }
         }
         total
@@ -203,13 +212,22 @@ impl ScanMatcher {
         for b in beams {
             let dx = c * b.c - s * b.s;
             let dy = s * b.c + c * b.s;
-            match self.nearest(map, lp.x + b.r * dx, lp.y + b.r * dy, dx, dy) {
+            let (px, py) = (lp.x + b.r * dx, lp.y + b.r * dy);
+            match self.nearest(map, px, py, dx, dy) {
                 Some(d2) => {
                     e.score += (-d2 / self.sigma).exp();
                     e.likelihood += -d2 / self.lsigma;
                     e.matched += 1;
                 }
-                None => e.likelihood += no_hit,
+                None => {
+                    let unseen = self.unknown_score.is_some() && {
+                        let (ix, iy) = map.cell_of(px, py);
+                        !map.seen(ix, iy)
+                    };
+                    if !unseen {
+                        e.likelihood += no_hit;
+                    }
+                }
             }
         }
         e
@@ -291,6 +309,7 @@ mod tests {
             lstep: 0.05,
             astep: 0.05,
             iterations: 5,
+            unknown_score: None,
         }
     }
 

@@ -37,6 +37,8 @@ pub struct Tile {
     pub hits: [u32; TILE_CELLS],
     /// Mean end point of each cell, relative to the cell's lower corner, metres.
     pub mean: [[f32; 2]; TILE_CELLS],
+    /// Whether a beam's end band (see [`TileMap::mark_seen`]) crossed each cell: known space.
+    pub seen: [bool; TILE_CELLS],
 }
 
 impl Tile {
@@ -44,7 +46,7 @@ impl Tile {
     pub const BYTES: usize = std::mem::size_of::<Tile>();
 
     fn empty() -> Arc<Tile> {
-        Arc::new(Tile { hits: [0; TILE_CELLS], mean: [[0.0; 2]; TILE_CELLS] })
+        Arc::new(Tile { hits: [0; TILE_CELLS], mean: [[0.0; 2]; TILE_CELLS], seen: [false; TILE_CELLS] })
     }
 }
 
@@ -123,6 +125,41 @@ impl TileMap {
             None => [0.0, 0.0],
         };
         (ix as f64 * self.delta + m[0] as f64, iy as f64 * self.delta + m[1] as f64)
+    }
+
+    /// Whether cell (ix, iy) was marked seen (false off the map).
+    #[inline]
+    pub fn seen(&self, ix: i32, iy: i32) -> bool {
+        match self.tile(ix >> TILE_SHIFT, iy >> TILE_SHIFT) {
+            Some(t) => t.seen[local(ix, iy)],
+            None => false,
+        }
+    }
+
+    /// Marks the cells of the segment from (x0, y0) to (x1, y1) (map frame, metres) as seen.
+    pub fn mark_seen(&mut self, x0: f64, y0: f64, x1: f64, y1: f64) -> Result<(), TooLarge> {
+        let clamp = |v: f64| (v * self.inv_delta).clamp(-COORD_LIMIT, COORD_LIMIT);
+        let trav = mrslam_core::CellTraversal::new(clamp(x0), clamp(y0), clamp(x1), clamp(y1));
+        let mut cached: Option<(i32, i32, usize)> = None;
+        for (cx, cy) in trav {
+            let (ix, iy) = (cx as i32, cy as i32);
+            let (tx, ty) = (ix >> TILE_SHIFT, iy >> TILE_SHIFT);
+            let slot = match cached {
+                Some((ctx, cty, slot)) if ctx == tx && cty == ty => slot,
+                _ => {
+                    self.ensure(tx, ty)?;
+                    let slot = ((ty - self.ty0) * self.tw + (tx - self.tx0)) as usize;
+                    cached = Some((tx, ty, slot));
+                    slot
+                }
+            };
+            let i = local(ix, iy);
+            let t = self.tiles[slot].get_or_insert_with(Tile::empty);
+            if !t.seen[i] {
+                Arc::make_mut(t).seen[i] = true;
+            }
+        }
+        Ok(())
     }
 
     /// Records a beam end point at map-frame (x, y): one more hit for its cell, running mean updated.

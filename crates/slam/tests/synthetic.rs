@@ -64,7 +64,6 @@ fn run_filter(run: &SyntheticRun, params: SlamParams, seed: u64) -> Rbpf {
 }
 
 #[test]
-#[ignore = "known failure: Hokuyo 4 m run drifts to 0.1-0.33 m RMS (target 0.05 m); see the crate's report"]
 fn beats_drifting_odometry_and_maps_the_office() {
     let run = office_run(&drifting(), 11);
     let t = std::time::Instant::now();
@@ -94,9 +93,9 @@ fn beats_drifting_odometry_and_maps_the_office() {
         secs
     );
     assert!(odo_rms >= 0.3, "odometry must drift for this test to mean anything: {odo_rms}");
-    // The brief's target is 0.05 m; this matcher reaches 0.04-0.15 m on this run depending on seeds (see
-    // the crate README / report): asserted here is what it reliably does, a wide margin over odometry.
-    assert!(slam_rms <= 0.2 && slam_rms * 5.0 <= odo_rms, "SLAM RMS {slam_rms} m");
+    // The target is 0.05 m; with the `seen_band` matcher of the preset this run measures 0.097 m (0.09-0.11 m
+    // over filter seeds 1, 2, 5; GMapping's plain matcher 0.33 m): asserted is what it reliably does.
+    assert!(slam_rms <= 0.15 && slam_rms * 20.0 <= odo_rms, "SLAM RMS {slam_rms} m");
     assert!(ai >= 0.95, "acceptance index {ai}");
     assert!(compared > 10_000);
     let (free, occ, _) = map.state_counts();
@@ -112,7 +111,8 @@ fn rplidar_preset_maps_the_office_too() {
     let rms = rms_error(&f.trajectory(), &run.truth);
     let (ai, _) = acceptance_index(&f.map().unwrap(), &run.truth_map, &run.truth[0].1);
     eprintln!("rplidar office loop: RMS {rms:.4} m, acceptance {ai:.4}");
-    assert!(rms <= 0.15, "{rms}");
+    // Measured 0.049 m (target 0.05 m); a little margin for float differences across platforms.
+    assert!(rms <= 0.06, "{rms}");
     assert!(ai >= 0.95, "{ai}");
 }
 
@@ -149,7 +149,9 @@ fn same_seed_same_trajectory_bit_for_bit() {
 #[test]
 fn update_schedule_and_events() {
     let run = office_run(&drifting(), 2);
-    let mut f = Rbpf::new(SlamParams::hokuyo(), run.laser_offset, 1).unwrap();
+    // A high threshold, so that this short run resamples: the preset's matcher keeps the weights even.
+    let params = SlamParams { resample_threshold: 0.9, ..SlamParams::hokuyo() };
+    let mut f = Rbpf::new(params, run.laser_offset, 1).unwrap();
     assert_eq!(f.neff(), 30.0);
     let mut processed = 0;
     let mut resampled = 0;
@@ -162,7 +164,7 @@ fn update_schedule_and_events() {
             UpdateOutcome::Processed(st) => {
                 processed += 1;
                 assert!(st.neff >= 1.0 - 1e-9 && st.neff <= 30.0 + 1e-9);
-                assert_eq!(st.resampled, st.neff < 15.0);
+                assert_eq!(st.resampled, st.neff < 27.0);
                 assert_eq!(f.resampled_last_update(), st.resampled);
                 if st.resampled {
                     resampled += 1;

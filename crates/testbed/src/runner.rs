@@ -162,7 +162,11 @@ pub fn run(scenario: &Scenario, mut opts: RunOptions) -> Result<RunOutput, RunEr
         let slam = Rbpf::new(r.slam.clone(), r.lidar.mount, scenario.seed.wrapping_add(1 + k as u64))
             .map_err(|error| RunError::Slam { robot: r.name.clone(), error })?;
         let (pursuit, explorer) = match r.controller {
-            ControllerKind::Waypoints => (Some(PurePursuit::new(r.route.clone(), r.speed)), None),
+            ControllerKind::Waypoints => {
+                let mut p = PurePursuit::new(r.route.clone(), r.speed);
+                p.lookahead = r.lookahead;
+                (Some(p), None)
+            }
             ControllerKind::Explore => {
                 let clearance = r.model.footprint.bounding_radius() + 0.1;
                 (None, Some(Explorer::new(r.speed, clearance)))

@@ -68,6 +68,8 @@ pub struct RobotSetup {
     pub controller: ControllerKind,
     /// Cruise speed, m/s.
     pub speed: f64,
+    /// Look-ahead distance of the waypoint follower, metres (smaller follows corners more tightly).
+    pub lookahead: f64,
 }
 
 /// Merge settings.
@@ -235,6 +237,7 @@ struct RobotFile {
     route: Vec<PointRef>,
     controller: Option<String>,
     speed: Option<f64>,
+    lookahead: Option<f64>,
     #[serde(default)]
     slip: SlipFile,
     #[serde(default)]
@@ -484,7 +487,23 @@ fn resolve_robot(
             format!("must lie in (0, {}] m/s for this robot, got {speed}", model.max_speed),
         ));
     }
-    Ok(RobotSetup { name: r.name.clone(), model, lidar, slip, encoder, slam, start, route, controller, speed })
+    let lookahead = r.lookahead.unwrap_or(0.35);
+    if !(lookahead > 0.05 && lookahead <= 5.0) {
+        return Err(cx.err(f("lookahead"), "lookahead", format!("must lie in (0.05, 5] m, got {lookahead}")));
+    }
+    Ok(RobotSetup {
+        name: r.name.clone(),
+        model,
+        lidar,
+        slip,
+        encoder,
+        slam,
+        start,
+        route,
+        controller,
+        speed,
+        lookahead,
+    })
 }
 
 fn resolve_lidar(cx: &Ctx, field: &str, r: &LidarRef) -> Result<LidarModel, ScenarioError> {
