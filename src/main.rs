@@ -32,6 +32,9 @@ enum Command {
     Run(cmd::run::RunArgs),
     /// Map a CARMEN log with GMapping-style particle filter SLAM.
     Slam(cmd::slam::SlamArgs),
+    /// Studies: many seeded merge trials across overlaps; success rates with intervals, plots, shards.
+    #[command(subcommand)]
+    Study(cmd::study::StudyCommand),
 }
 
 fn main() -> ExitCode {
@@ -43,6 +46,7 @@ fn main() -> ExitCode {
         Command::Features(a) => cmd::features::run(a),
         Command::Slam(a) => cmd::slam::run(a),
         Command::Run(a) => cmd::run::run(a),
+        Command::Study(c) => cmd::study::run(c),
     };
     match result {
         Ok(code) => code,

@@ -6,3 +6,4 @@ pub mod map;
 pub mod merge;
 pub mod run;
 pub mod slam;
+pub mod study;

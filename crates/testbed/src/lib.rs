@@ -5,3 +5,4 @@ pub mod eval;
 pub mod report;
 pub mod runner;
 pub mod scenario;
+pub mod study;

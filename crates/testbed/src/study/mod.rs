@@ -1,0 +1,86 @@
+//! Studies: many seeded merge trials across overlaps, summarised with confidence intervals and plotted.
+//!
+//! Two kinds of trial produce the same rows ([`results::TrialRow`]):
+//! - **map level** ([`overlap`]): a ground-truth map (generated floor plan, a world's true map, or a real
+//!   map) is cut into a pair with a chosen overlap ([`mrslam_merge::pairs::cut_pair`]); every algorithm
+//!   merges the pair through the verification gate and is scored against the pair's true transform;
+//! - **simulation level** ([`sweep`]): a sweep file varies a scenario (seeds, how far each robot's route
+//!   reaches); each variant runs the whole simulation, SLAM and merge, and its overlap is the one the
+//!   robots actually observed.
+//!
+//! Rows go to `results.csv` ([`results`]); [`summary`] bins them by overlap with Wilson intervals
+//! ([`wilson`]) into `summary.csv`; [`plot`] draws `plot.png`. [`shard`] splits one study across processes
+//! and [`results::collect`] joins the shards again. Every trial is seeded from (study seed, overlap index,
+//! trial index) alone ([`trial`]), so a shard computes exactly the rows the whole study would.
+
+pub mod algorithms;
+pub mod overlap;
+pub mod plot;
+pub mod range;
+pub mod results;
+pub mod shard;
+pub mod summary;
+pub mod sweep;
+pub mod trial;
+pub mod wilson;
+
+use std::path::PathBuf;
+
+/// Why a study could not run or its files could not be read.
+#[derive(Debug, thiserror::Error)]
+pub enum StudyError {
+    /// A parameter is out of range or malformed; the message names it.
+    #[error("{0}")]
+    Invalid(String),
+    /// A file could not be read or written.
+    #[error("{path}: {message}")]
+    File {
+        /// File at fault.
+        path: PathBuf,
+        /// What went wrong.
+        message: String,
+    },
+    /// A results file is malformed, or shards disagree.
+    #[error("{path}:{line}: {message}")]
+    Results {
+        /// File at fault.
+        path: PathBuf,
+        /// 1-based line (0 when not tied to one line).
+        line: usize,
+        /// What is wrong.
+        message: String,
+    },
+    /// A simulation trial failed.
+    #[error("trial {trial}: {message}")]
+    Trial {
+        /// Trial index.
+        trial: usize,
+        /// What went wrong.
+        message: String,
+    },
+}
+
+impl StudyError {
+    pub(crate) fn file(path: impl Into<PathBuf>, e: impl std::fmt::Display) -> StudyError {
+        StudyError::File { path: path.into(), message: e.to_string() }
+    }
+}
+
+pub use algorithms::{STUDY_ALGORITHMS, study_merger};
+pub use overlap::{MapSource, OverlapStudy, run_overlap_study};
+pub use range::parse_range;
+pub use results::{TrialRow, collect, read_results, write_results};
+pub use shard::Shard;
+pub use summary::{SummaryRow, summarise, write_summary};
+pub use sweep::{Sweep, run_sweep};
+pub use wilson::wilson_interval;
+
+/// Writes `results.csv`, `summary.csv` and `plot.png` of `rows` into `dir` (created if needed).
+pub fn write_outputs(rows: &[TrialRow], dir: &std::path::Path) -> Result<Vec<SummaryRow>, StudyError> {
+    std::fs::create_dir_all(dir).map_err(|e| StudyError::file(dir, e))?;
+    write_results(rows, &dir.join("results.csv"))?;
+    let summary = summarise(rows);
+    write_summary(&summary, &dir.join("summary.csv"))?;
+    plot::draw(&summary, &dir.join("plot.png"))?;
+    Ok(summary)
+}

@@ -1,0 +1,201 @@
+//! Map-level studies: cut ground-truth maps into pairs of chosen overlap, merge each pair with every
+//! algorithm through the verification gate, score against the pair's true transform.
+
+use super::StudyError;
+use super::algorithms::{check_algorithms, study_merger};
+use super::results::{TrialRow, sort_rows};
+use super::shard::Shard;
+use super::trial::{TrialSpec, mix, trials};
+use crate::eval::transform_error;
+use mrslam_core::OccupancyGrid;
+use mrslam_merge::floorplan::{FloorplanParams, generate};
+use mrslam_merge::pairs::{PairSpec, cut_pair};
+use mrslam_merge::{MergeParams, merge};
+use rayon::prelude::*;
+
+/// Where a study's ground-truth maps come from.
+#[derive(Debug, Clone)]
+pub enum MapSource {
+    /// `count` procedurally generated floor plans; repetition `rep` of every overlap uses plan `rep % count`.
+    Floorplans {
+        /// How many distinct plans.
+        count: usize,
+        /// Their shape.
+        params: FloorplanParams,
+    },
+    /// One map for every trial: a world's true map, or a real map.
+    Map(OccupancyGrid),
+}
+
+/// A map-level study.
+#[derive(Debug, Clone)]
+pub struct OverlapStudy {
+    /// Ground-truth maps.
+    pub source: MapSource,
+    /// Target overlaps (Jaccard of the halves' known cells).
+    pub overlaps: Vec<f64>,
+    /// Trials per overlap.
+    pub trials: usize,
+    /// Algorithms, in the order rows are written.
+    pub algorithms: Vec<String>,
+    /// Study seed.
+    pub seed: u64,
+    /// Success: rotation error at most this, degrees.
+    pub max_rotation_deg: f64,
+    /// Success: translation error at most this many cells of the map.
+    pub max_translation_cells: f64,
+    /// Largest shift of the moved half, metres.
+    pub max_shift_m: f64,
+    /// Which trials this process runs.
+    pub shard: Shard,
+}
+
+impl OverlapStudy {
+    /// Checks the parameters.
+    pub fn validate(&self) -> Result<(), StudyError> {
+        let bad = |m: String| Err(StudyError::Invalid(m));
+        if self.trials == 0 {
+            return bad("--trials must be at least 1".into());
+        }
+        if self.overlaps.is_empty() {
+            return bad("no overlaps to study".into());
+        }
+        check_algorithms(&self.algorithms)?;
+        if let MapSource::Floorplans { count: 0, .. } = self.source {
+            return bad("--floorplans must be at least 1".into());
+        }
+        if !(self.max_rotation_deg >= 0.0 && self.max_translation_cells >= 0.0 && self.max_shift_m >= 0.0) {
+            return bad("success thresholds and the shift must not be negative".into());
+        }
+        Ok(())
+    }
+
+    /// The trials this shard runs, in index order.
+    pub fn selected_trials(&self) -> Vec<TrialSpec> {
+        trials(self.seed, &self.overlaps, self.trials).into_iter().filter(|t| self.shard.selects(t.trial)).collect()
+    }
+}
+
+/// The true map of a world file at `resolution` metres per cell.
+pub fn world_truth(path: &std::path::Path, resolution: f64) -> Result<OccupancyGrid, StudyError> {
+    let spec = mrslam_sim::WorldSpec::from_toml_file(path).map_err(|e| StudyError::file(path, e))?;
+    let world = mrslam_sim::World::from_spec(&spec).map_err(|e| StudyError::file(path, e))?;
+    world.true_map(resolution).map_err(|e| StudyError::file(path, e))
+}
+
+/// The seed of floor plan `k` of a study seeded `seed`.
+pub fn floorplan_seed(seed: u64, k: usize) -> u64 {
+    mix(mix(seed ^ 0xf100_4b1a_0000_0000) ^ k as u64)
+}
+
+/// Runs the study's trials of this shard in parallel, calling `progress` after each; rows sorted by trial,
+/// then algorithm in the study's order.
+pub fn run_overlap_study(study: &OverlapStudy, progress: &(dyn Fn() + Sync)) -> Result<Vec<TrialRow>, StudyError> {
+    study.validate()?;
+    let selected = study.selected_trials();
+    let plans: Vec<Option<OccupancyGrid>> = match &study.source {
+        MapSource::Floorplans { count, params } => {
+            // Only the plans this shard uses.
+            let used: Vec<usize> = (0..*count).filter(|k| selected.iter().any(|t| t.rep % count == *k)).collect();
+            let built: Vec<(usize, OccupancyGrid)> =
+                used.par_iter().map(|&k| (k, generate(floorplan_seed(study.seed, k), params))).collect();
+            let mut v = vec![None; *count];
+            for (k, g) in built {
+                v[k] = Some(g);
+            }
+            v
+        }
+        MapSource::Map(g) => vec![Some(g.clone())],
+    };
+    let mut rows: Vec<TrialRow> = selected
+        .par_iter()
+        .map(|t| {
+            // Every plan a selected trial uses was built above.
+            let r = plans[t.rep % plans.len()].as_ref().map(|map| run_trial(study, map, t)).unwrap_or_default();
+            progress();
+            r
+        })
+        .flatten()
+        .collect();
+    sort_rows(&mut rows, &study.algorithms);
+    Ok(rows)
+}
+
+/// One trial: cut the pair, merge it with every algorithm, score.
+fn run_trial(study: &OverlapStudy, map: &OccupancyGrid, t: &TrialSpec) -> Vec<TrialRow> {
+    let spec = PairSpec { overlap: t.overlap_target, max_shift_m: study.max_shift_m, rotate: true };
+    let pair = cut_pair(map, &spec, t.seed);
+    let max_translation_m = study.max_translation_cells * map.resolution();
+    study
+        .algorithms
+        .iter()
+        .filter_map(|name| {
+            let merger = study_merger(name, t.seed)?;
+            let out = merge(merger.as_ref(), &pair.a, &pair.b, &MergeParams::default());
+            let err = out.report.transform.map(|x| transform_error(&x.to_pose(), &pair.t_a_b));
+            let accepted = out.report.accepted;
+            let success = accepted
+                && err.is_some_and(|(r, d)| r.to_degrees() <= study.max_rotation_deg && d <= max_translation_m);
+            Some(TrialRow {
+                trial: t.trial,
+                overlap_target: Some(t.overlap_target),
+                overlap: pair.overlap,
+                seed: t.seed,
+                algorithm: name.clone(),
+                accepted,
+                success,
+                false_merge: accepted && !success,
+                rotation_error_deg: err.map(|e| e.0.to_degrees()),
+                translation_error_m: err.map(|e| e.1),
+                time_ms: out.report.time_ms,
+            })
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn small() -> OverlapStudy {
+        OverlapStudy {
+            source: MapSource::Floorplans {
+                count: 2,
+                params: FloorplanParams { width_m: 10.0, height_m: 8.0, ..FloorplanParams::default() },
+            },
+            overlaps: vec![0.3, 0.6],
+            trials: 2,
+            algorithms: vec!["sift".into()],
+            seed: 3,
+            max_rotation_deg: 2.0,
+            max_translation_cells: 2.0,
+            max_shift_m: 3.0,
+            shard: Shard::ALL,
+        }
+    }
+
+    #[test]
+    fn shards_compute_the_rows_of_the_whole() {
+        let whole = run_overlap_study(&small(), &|| {}).unwrap();
+        assert_eq!(whole.len(), 4);
+        let mut parts = Vec::new();
+        for k in 0..2 {
+            let s = OverlapStudy { shard: Shard::new(k, 2).unwrap(), ..small() };
+            parts.extend(run_overlap_study(&s, &|| {}).unwrap());
+        }
+        sort_rows(&mut parts, &["sift".to_string()]);
+        let strip = |r: &TrialRow| TrialRow { time_ms: 0.0, ..r.clone() };
+        assert_eq!(whole.iter().map(strip).collect::<Vec<_>>(), parts.iter().map(strip).collect::<Vec<_>>());
+        for r in &whole {
+            assert!((r.overlap - r.overlap_target.unwrap()).abs() < 0.02, "{r:?}");
+            assert_eq!(r.false_merge, r.accepted && !r.success);
+        }
+    }
+
+    #[test]
+    fn bad_parameters_are_refused() {
+        assert!(run_overlap_study(&OverlapStudy { trials: 0, ..small() }, &|| {}).is_err());
+        let e = run_overlap_study(&OverlapStudy { algorithms: vec!["nope".into()], ..small() }, &|| {});
+        assert!(e.unwrap_err().to_string().contains("unknown algorithm"));
+    }
+}

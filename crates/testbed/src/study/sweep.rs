@@ -1,0 +1,288 @@
+//! Simulation-level studies: a sweep file varies a scenario; every variant runs simulation, SLAM and merge.
+//!
+//! ```toml
+//! scenario = "paper_corridor.toml"     # relative to the sweep file
+//! algorithms = ["sift", "rmap"]        # default: the scenario's
+//! seeds = [1, 2, 3]                    # every variant runs once per seed
+//!
+//! [[vary]]                             # all [[vary]] lists step together (equal lengths):
+//! robot = "experia"                    # variant i sets each field to its i-th value
+//! field = "route_end_x"                # route_end_x, route_end_y (the last waypoint), or speed
+//! values = [24.2, 28.0, 32.0]
+//! ```
+//!
+//! Trials: variant-major, `trial = variant * seeds.len() + seed index`. A trial's overlap is the run's
+//! observed overlap (Jaccard of the true cells each robot's beams crossed), not an assumed one.
+
+use super::StudyError;
+use super::algorithms::{check_algorithms, study_merger};
+use super::results::{TrialRow, sort_rows};
+use super::shard::Shard;
+use crate::eval::transform_error;
+use crate::runner::{RunOptions, merger_for, run};
+use crate::scenario::Scenario;
+use mrslam_core::pose;
+use mrslam_merge::{MergeParams, merge};
+use mrslam_sim::World;
+use rayon::prelude::*;
+use serde::Deserialize;
+use std::path::{Path, PathBuf};
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SweepFile {
+    scenario: String,
+    algorithms: Option<Vec<String>>,
+    seeds: Vec<u64>,
+    #[serde(default)]
+    vary: Vec<VaryFile>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct VaryFile {
+    robot: String,
+    field: String,
+    values: Vec<f64>,
+}
+
+/// A parameter a sweep may vary.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Field {
+    /// x of the robot's last waypoint, metres.
+    RouteEndX,
+    /// y of the robot's last waypoint, metres.
+    RouteEndY,
+    /// Cruise speed, m/s.
+    Speed,
+}
+
+/// Field names a sweep accepts.
+pub const FIELDS: &[&str] = &["route_end_x", "route_end_y", "speed"];
+
+/// One varied parameter.
+#[derive(Debug, Clone)]
+pub struct Vary {
+    /// Index of the robot in the scenario.
+    pub robot: usize,
+    /// The field.
+    pub field: Field,
+    /// Its value in each variant.
+    pub values: Vec<f64>,
+}
+
+/// A resolved sweep.
+#[derive(Debug, Clone)]
+pub struct Sweep {
+    /// The sweep file.
+    pub path: PathBuf,
+    /// The base scenario.
+    pub scenario: Scenario,
+    /// Algorithms, in row order.
+    pub algorithms: Vec<String>,
+    /// Seeds each variant runs with.
+    pub seeds: Vec<u64>,
+    /// The varied parameters (stepping together).
+    pub vary: Vec<Vary>,
+}
+
+fn line_of(text: &str, needle: &str) -> usize {
+    text.lines().position(|l| l.contains(needle)).map_or(0, |i| i + 1)
+}
+
+impl Sweep {
+    /// Reads and checks a sweep file (and the scenario it names); errors name the file, line and field.
+    pub fn from_file(path: &Path) -> Result<Sweep, StudyError> {
+        let text = std::fs::read_to_string(path).map_err(|e| StudyError::file(path, e))?;
+        let at = |line: usize, message: String| StudyError::Results { path: path.to_path_buf(), line, message };
+        let file: SweepFile = toml::from_str(&text).map_err(|e| {
+            let line = e.span().map_or(0, |s| text[..s.start.min(text.len())].matches('\n').count() + 1);
+            at(line, e.message().to_string())
+        })?;
+        let dir = path.parent().unwrap_or(Path::new("."));
+        let scenario = Scenario::from_file(&dir.join(&file.scenario))
+            .map_err(|e| at(line_of(&text, "scenario"), format!("scenario: {e}")))?;
+        let algorithms = file.algorithms.clone().unwrap_or_else(|| scenario.merge.algorithms.clone());
+        check_algorithms(&algorithms).map_err(|e| at(line_of(&text, "algorithms"), format!("algorithms: {e}")))?;
+        if file.seeds.is_empty() {
+            return Err(at(line_of(&text, "seeds"), "seeds: give at least one seed".into()));
+        }
+        let mut vary = Vec::new();
+        for (i, v) in file.vary.iter().enumerate() {
+            let f = |name: &str| format!("vary[{i}].{name}");
+            let robot = scenario.robots.iter().position(|r| r.name == v.robot).ok_or_else(|| {
+                let names: Vec<&str> = scenario.robots.iter().map(|r| r.name.as_str()).collect();
+                at(
+                    line_of(&text, &format!("\"{}\"", v.robot)),
+                    format!("{}: no robot `{}` in the scenario (robots: {})", f("robot"), v.robot, names.join(", ")),
+                )
+            })?;
+            let field = match v.field.as_str() {
+                "route_end_x" => Field::RouteEndX,
+                "route_end_y" => Field::RouteEndY,
+                "speed" => Field::Speed,
+                other => {
+                    return Err(at(
+                        line_of(&text, &format!("\"{other}\"")),
+                        format!("{}: unknown field `{other}` (expected one of {})", f("field"), FIELDS.join(", ")),
+                    ));
+                }
+            };
+            if v.values.is_empty() {
+                return Err(at(line_of(&text, "values"), format!("{}: give at least one value", f("values"))));
+            }
+            if let Some(first) = file.vary.first()
+                && first.values.len() != v.values.len()
+            {
+                return Err(at(
+                    0,
+                    format!(
+                        "{}: {} values, but vary[0] has {}: all [[vary]] lists step together and need equal lengths",
+                        f("values"),
+                        v.values.len(),
+                        first.values.len()
+                    ),
+                ));
+            }
+            vary.push(Vary { robot, field, values: v.values.clone() });
+        }
+        let sweep = Sweep { path: path.to_path_buf(), scenario, algorithms, seeds: file.seeds, vary };
+        // Every variant must be drivable: check each waypoint and speed now, not an hour into the study.
+        let world = World::from_spec(&sweep.scenario.world).map_err(|e| at(0, e.to_string()))?;
+        for k in 0..sweep.variants() {
+            let s = sweep.variant(k, sweep.seeds[0]);
+            for (i, v) in sweep.vary.iter().enumerate() {
+                let r = &s.robots[v.robot];
+                let value = v.values[k];
+                let problem = match v.field {
+                    Field::Speed => (!(value > 0.0 && value <= r.model.max_speed))
+                        .then(|| format!("speed {value} outside (0, {}] m/s", r.model.max_speed)),
+                    Field::RouteEndX | Field::RouteEndY => r.route.last().and_then(|p| {
+                        let (lo, hi) = world.bounds();
+                        if p.x < lo.x || p.y < lo.y || p.x > hi.x || p.y > hi.y {
+                            Some(format!("waypoint ({:.2}, {:.2}) lies outside the world", p.x, p.y))
+                        } else if world.footprint_collides(&r.model.footprint, &pose(p.x, p.y, 0.0)) {
+                            Some(format!("the robot cannot stand at waypoint ({:.2}, {:.2})", p.x, p.y))
+                        } else {
+                            None
+                        }
+                    }),
+                };
+                if let Some(p) = problem {
+                    return Err(at(line_of(&text, "values"), format!("vary[{i}].values[{k}] = {value}: {p}")));
+                }
+            }
+        }
+        Ok(sweep)
+    }
+
+    /// Number of variants (1 when nothing varies).
+    pub fn variants(&self) -> usize {
+        self.vary.first().map_or(1, |v| v.values.len())
+    }
+
+    /// Number of trials: variants × seeds.
+    pub fn trials(&self) -> usize {
+        self.variants() * self.seeds.len()
+    }
+
+    /// What trial `trial` runs, e.g. `seed 7, experia.route_end_x=29, prawn.route_end_x=21`.
+    pub fn describe(&self, trial: usize) -> String {
+        let n = self.seeds.len();
+        let mut s = format!("seed {}", self.seeds[trial % n]);
+        for v in &self.vary {
+            let field = FIELDS[v.field as usize];
+            s.push_str(&format!(", {}.{field}={}", self.scenario.robots[v.robot].name, v.values[trial / n]));
+        }
+        s
+    }
+
+    /// The scenario of variant `k` run with `seed`.
+    pub fn variant(&self, k: usize, seed: u64) -> Scenario {
+        let mut s = self.scenario.clone();
+        s.seed = seed;
+        for v in &self.vary {
+            let r = &mut s.robots[v.robot];
+            let value = v.values[k];
+            match v.field {
+                Field::RouteEndX => {
+                    if let Some(p) = r.route.last_mut() {
+                        p.x = value;
+                    }
+                }
+                Field::RouteEndY => {
+                    if let Some(p) = r.route.last_mut() {
+                        p.y = value;
+                    }
+                }
+                Field::Speed => r.speed = value,
+            }
+        }
+        s
+    }
+}
+
+/// Runs the sweep's trials of this shard in parallel, calling `progress` after each.
+pub fn run_sweep(sweep: &Sweep, shard: Shard, progress: &(dyn Fn() + Sync)) -> Result<Vec<TrialRow>, StudyError> {
+    let n_seeds = sweep.seeds.len();
+    let selected: Vec<usize> = (0..sweep.trials()).filter(|t| shard.selects(*t)).collect();
+    let rows: Vec<Vec<TrialRow>> = selected
+        .par_iter()
+        .map(|&trial| {
+            let scenario = sweep.variant(trial / n_seeds, sweep.seeds[trial % n_seeds]);
+            let r = run_trial(sweep, &scenario, trial);
+            progress();
+            r
+        })
+        .collect::<Result<_, _>>()?;
+    let mut rows: Vec<TrialRow> = rows.into_iter().flatten().collect();
+    sort_rows(&mut rows, &sweep.algorithms);
+    Ok(rows)
+}
+
+fn run_trial(sweep: &Sweep, scenario: &Scenario, trial: usize) -> Result<Vec<TrialRow>, StudyError> {
+    let fail = |m: String| StudyError::Trial { trial, message: m };
+    // The runner merges with the algorithms it knows (and so finds the true transform); the others run here
+    // on the same maps.
+    let mut by_runner: Vec<String> =
+        sweep.algorithms.iter().filter(|a| merger_for(a, scenario).is_ok()).cloned().collect();
+    if by_runner.is_empty() {
+        by_runner.push("sift".into());
+    }
+    let out = run(scenario, RunOptions { algorithms: Some(by_runner), progress: None })
+        .map_err(|e| fail(format!("seed {}: {e}", scenario.seed)))?;
+    let report = &out.report;
+    let true_t = report.merges.first().map(|m| m.true_transform.to_pose()).ok_or_else(|| fail("no merge".into()))?;
+    let [host, other] = &report.merge_pair;
+    let ok = |r: f64, t: f64| r <= scenario.success.rotation_deg && t <= scenario.success.translation_m;
+    let mut rows = Vec::new();
+    for name in &sweep.algorithms {
+        let row = |accepted: bool, success: bool, err: Option<(f64, f64)>, time_ms: f64| TrialRow {
+            trial,
+            overlap_target: None,
+            overlap: report.observed_overlap,
+            seed: scenario.seed,
+            algorithm: name.clone(),
+            accepted,
+            success,
+            false_merge: accepted && !success,
+            rotation_error_deg: err.map(|e| e.0),
+            translation_error_m: err.map(|e| e.1),
+            time_ms,
+        };
+        if let Some(m) = report.merges.iter().find(|m| &m.algorithm == name) {
+            let err = m.rotation_error_deg.zip(m.translation_error_m);
+            rows.push(row(m.accepted, m.success, err, m.time_ms));
+        } else {
+            let merger = study_merger(name, scenario.seed).ok_or_else(|| fail(format!("unknown algorithm {name}")))?;
+            let o = merge(merger.as_ref(), &out.maps[host], &out.maps[other], &MergeParams::default());
+            let err = o.report.transform.map(|x| {
+                let (r, t) = transform_error(&x.to_pose(), &true_t);
+                (r.to_degrees(), t)
+            });
+            let success = o.report.accepted && err.is_some_and(|(r, t)| ok(r, t));
+            rows.push(row(o.report.accepted, success, err, o.report.time_ms));
+        }
+    }
+    Ok(rows)
+}

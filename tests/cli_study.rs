@@ -1,0 +1,172 @@
+//! `mrslam study`, as a user would: a small map-level study, its files, its shards, and bad input.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn mrslam(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_mrslam")).args(args).output().expect("mrslam runs")
+}
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+const COLUMNS: &str = "trial,overlap_target,overlap,seed,algorithm,accepted,success,false_merge,\
+rotation_error_deg,translation_error_m,time_ms";
+
+/// A small study: 3 overlaps x 4 trials x (sift, rmap) on 12 m x 10 m floor plans.
+fn small_study(out: &Path, extra: &[&str]) -> Output {
+    let mut args = vec![
+        "study",
+        "overlap",
+        "--floorplans",
+        "2",
+        "--floorplan-size",
+        "12x10",
+        "--overlaps",
+        "0.2:0.6:0.2",
+        "--trials",
+        "4",
+        "--algorithms",
+        "sift,rmap",
+        "--seed",
+        "5",
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    args.extend_from_slice(extra);
+    mrslam(&args)
+}
+
+fn ok(o: &Output) {
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "stdout: {}\nstderr: {}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    );
+}
+
+fn csv(path: &Path) -> (String, Vec<Vec<String>>) {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    let header = lines.next().unwrap().to_string();
+    (header, lines.map(|l| l.split(',').map(str::to_string).collect()).collect())
+}
+
+#[test]
+fn a_small_study_writes_consistent_results_summary_and_plot_and_shards_agree() {
+    let dir = tempfile::tempdir().unwrap();
+    let whole = dir.path().join("whole");
+    let o = small_study(&whole, &[]);
+    ok(&o);
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(stdout.contains("trials/s"), "{stdout}");
+
+    let (header, rows) = csv(&whole.join("results.csv"));
+    assert_eq!(header, COLUMNS);
+    assert_eq!(rows.len(), 3 * 4 * 2);
+    for (i, r) in rows.iter().enumerate() {
+        assert_eq!(r.len(), 11);
+        assert_eq!(r[0], (i / 2).to_string(), "sorted by trial");
+        assert_eq!(r[4], if i % 2 == 0 { "sift" } else { "rmap" }, "then by algorithm");
+        let (accepted, success, false_merge) = (r[5] == "true", r[6] == "true", r[7] == "true");
+        assert_eq!(false_merge, accepted && !success, "{r:?}");
+        if success {
+            let rot: f64 = r[8].parse().unwrap();
+            let tr: f64 = r[9].parse().unwrap();
+            assert!(rot <= 2.0 && tr <= 0.1 + 1e-9, "{r:?}");
+        }
+        let target: f64 = r[1].parse().unwrap();
+        let overlap: f64 = r[2].parse().unwrap();
+        assert!((target - overlap).abs() < 0.03, "{r:?}");
+    }
+
+    // summary.csv agrees with results.csv.
+    let (sheader, summary) = csv(&whole.join("summary.csv"));
+    assert!(sheader.starts_with("overlap_bin,algorithm,trials,successes,success_rate,success_lo,success_hi"));
+    assert_eq!(summary.len(), 3 * 2);
+    for s in &summary {
+        let sel: Vec<&Vec<String>> = rows.iter().filter(|r| r[1] == s[0] && r[4] == s[1]).collect();
+        assert_eq!(s[2], sel.len().to_string(), "{s:?}");
+        assert_eq!(s[3], sel.iter().filter(|r| r[6] == "true").count().to_string(), "{s:?}");
+        assert_eq!(s[7], sel.iter().filter(|r| r[7] == "true").count().to_string(), "{s:?}");
+        let (rate, lo, hi): (f64, f64, f64) = (s[4].parse().unwrap(), s[5].parse().unwrap(), s[6].parse().unwrap());
+        assert!(lo <= rate && rate <= hi, "{s:?}");
+    }
+
+    let img = image::open(whole.join("plot.png")).expect("plot.png decodes");
+    assert_eq!((img.width(), img.height()), (1200, 900));
+
+    // Two shards, collected, are the whole study row for row (time_ms, wall time, aside).
+    let (s0, s1, joined) = (dir.path().join("s0"), dir.path().join("s1"), dir.path().join("joined"));
+    ok(&small_study(&s0, &["--shard", "0/2"]));
+    ok(&small_study(&s1, &["--shard", "1/2"]));
+    assert_eq!(csv(&s0.join("results.csv")).1.len(), 12);
+    let o =
+        mrslam(&["study", "collect", s1.to_str().unwrap(), s0.to_str().unwrap(), "--out", joined.to_str().unwrap()]);
+    ok(&o);
+    let (jh, jrows) = csv(&joined.join("results.csv"));
+    assert_eq!(jh, COLUMNS);
+    let strip = |rows: &[Vec<String>]| rows.iter().map(|r| r[..10].to_vec()).collect::<Vec<_>>();
+    assert_eq!(strip(&jrows), strip(&rows));
+    let img = image::open(joined.join("plot.png")).expect("collected plot.png decodes");
+    assert_eq!((img.width(), img.height()), (1200, 900));
+    let strip_time = |rows: &[Vec<String>]| rows.iter().map(|r| r[..9].to_vec()).collect::<Vec<_>>();
+    assert_eq!(strip_time(&csv(&joined.join("summary.csv")).1), strip_time(&summary));
+
+    // Collecting a shard twice is refused.
+    let o =
+        mrslam(&["study", "collect", s0.to_str().unwrap(), s0.to_str().unwrap(), "--out", joined.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("also in"));
+}
+
+fn refused(args: &[&str], needle: &str) {
+    let o = mrslam(args);
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{args:?}: {e}");
+    assert!(!e.contains("panicked"), "{e}");
+    assert!(e.contains(needle), "{args:?}: stderr lacks `{needle}`: {e}");
+}
+
+#[test]
+fn bad_input_is_refused_with_a_clear_message() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let out = out.to_str().unwrap();
+    let base = ["study", "overlap", "--floorplans", "1", "--quiet", "--out", out];
+    let with = |extra: &[&'static str]| base.iter().copied().chain(extra.iter().copied()).collect::<Vec<&str>>();
+    refused(&with(&["--overlaps", "0.5:0.2:0.1"]), "empty");
+    refused(&with(&["--trials", "0"]), "--trials");
+    refused(&with(&["--shard", "3/2"]), "shard");
+    refused(&with(&["--algorithms", "sift,magic"]), "unknown algorithm `magic`");
+    refused(&with(&["--floorplan-size", "12by10"]), "--floorplan-size");
+
+    // A sweep file missing a parameter, and one naming an unknown robot.
+    let sweep = dir.path().join("sweep.toml");
+    let scenario = root().join("scenarios/paper_corridor.toml");
+    let head = format!("scenario = {:?}\nseeds = [1]\n", scenario.display().to_string());
+    std::fs::write(&sweep, format!("{head}[[vary]]\nrobot = \"experia\"\nfield = \"route_end_x\"\n")).unwrap();
+    refused(&["study", "scenario", sweep.to_str().unwrap(), "--out", out], "values");
+    std::fs::write(&sweep, format!("scenario = {:?}\n", scenario.display().to_string())).unwrap();
+    refused(&["study", "scenario", sweep.to_str().unwrap(), "--out", out], "seeds");
+    std::fs::write(&sweep, format!("{head}[[vary]]\nrobot = \"robbie\"\nfield = \"route_end_x\"\nvalues = [20.0]\n"))
+        .unwrap();
+    refused(&["study", "scenario", sweep.to_str().unwrap(), "--out", out], "no robot `robbie`");
+    std::fs::write(&sweep, format!("{head}[[vary]]\nrobot = \"experia\"\nfield = \"route_end_x\"\nvalues = [99.0]\n"))
+        .unwrap();
+    refused(&["study", "scenario", sweep.to_str().unwrap(), "--out", out], "outside the world");
+}
+
+#[test]
+fn the_shipped_sweep_file_is_valid() {
+    let sweep = root().join("scenarios/corridor_sweep.toml");
+    let o = mrslam(&["study", "scenario", sweep.to_str().unwrap(), "--dry-run", "--out", "/nonexistent/never"]);
+    ok(&o);
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(stdout.contains("6 trials"), "{stdout}");
+    assert!(stdout.contains("experia.route_end_x=34"), "{stdout}");
+}
