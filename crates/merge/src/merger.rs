@@ -1,6 +1,7 @@
 //! The merge pipeline shared by every algorithm: align, verify, fuse, report.
 
 use crate::fuse::{FusionRule, fuse};
+use crate::refine::{RefineParams, refine, wall_points};
 use crate::report::{MergeReport, TransformXyt};
 use crate::verify::{Agreement, VerifyParams, agreement, ambiguity, confidence, rejection_reason};
 use mrslam_core::{OccupancyGrid, Pose2};
@@ -66,11 +67,18 @@ pub struct MergeParams {
     pub verify_enabled: bool,
     /// How aligned cells combine.
     pub fusion: FusionRule,
+    /// Wall ICP applied to the algorithm's transform before verification.
+    pub refine: RefineParams,
 }
 
 impl Default for MergeParams {
     fn default() -> Self {
-        MergeParams { verify: VerifyParams::default(), verify_enabled: true, fusion: FusionRule::LogOddsSum }
+        MergeParams {
+            verify: VerifyParams::default(),
+            verify_enabled: true,
+            fusion: FusionRule::LogOddsSum,
+            refine: RefineParams::default(),
+        }
     }
 }
 
@@ -114,7 +122,13 @@ pub fn merge(merger: &dyn Merger, a: &OccupancyGrid, b: &OccupancyGrid, p: &Merg
             return MergeOutcome { report, merged: None, evidence: no.evidence };
         }
     };
+    let mut alignment = alignment;
     let mut timings = alignment.timings_ms.clone();
+    if p.refine.enabled {
+        let t = Instant::now();
+        alignment.transform = refine(a, &wall_points(b), &alignment.transform, &p.refine);
+        timings.insert("refine".into(), ms(t));
+    }
     let t = Instant::now();
     let agr: Agreement = agreement(a, b, &alignment.transform);
     timings.insert("verify".into(), ms(t));
