@@ -31,7 +31,7 @@ impl PurePursuit {
         PurePursuit {
             lookahead: 0.6,
             speed,
-            max_turn: 1.0,
+            max_turn: 0.6,
             max_accel: 0.5,
             goal_tolerance: 0.1,
             turn_in_place: 1.0,
