@@ -124,9 +124,11 @@ pub fn merge(merger: &dyn Merger, a: &OccupancyGrid, b: &OccupancyGrid, p: &Merg
     };
     let mut alignment = alignment;
     let mut timings = alignment.timings_ms.clone();
+    // b's walls serve both the refinement and the ambiguity check: collect them once.
+    let walls_b = if p.refine.enabled || p.verify_enabled { wall_points(b) } else { Vec::new() };
     if p.refine.enabled {
         let t = Instant::now();
-        alignment.transform = refine(a, &wall_points(b), &alignment.transform, &p.refine);
+        alignment.transform = refine(a, &walls_b, &alignment.transform, &p.refine);
         timings.insert("refine".into(), ms(t));
     }
     let t = Instant::now();
@@ -138,7 +140,7 @@ pub fn merge(merger: &dyn Merger, a: &OccupancyGrid, b: &OccupancyGrid, p: &Merg
     let mut ambiguous = None;
     if reason.is_none() && p.verify_enabled {
         let t = Instant::now();
-        let amb = ambiguity(a, b, &alignment.transform, p.verify.ambiguity_shift_m);
+        let amb = ambiguity(a, &walls_b, &alignment.transform, p.verify.ambiguity_shift_m);
         timings.insert("ambiguity".into(), ms(t));
         ambiguous = Some(amb);
         if amb >= p.verify.max_ambiguity {

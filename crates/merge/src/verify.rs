@@ -128,16 +128,12 @@ pub fn wall_hits(a: &OccupancyGrid, walls_b: &[Point2<f64>], t_a_b: &Pose2) -> (
 }
 
 /// How well the maps still agree when b slides `shift` metres (8 directions, in b's frame) away from `t_a_b`:
-/// the largest count of b's walls meeting a's walls over the slides, as a share of the count in place.
+/// the largest count of b's walls (`walls_b`, see [`crate::refine::wall_points`]) meeting a's walls over the
+/// slides, as a share of the count in place.
 ///
 /// Near 1 means the alignment is not pinned down along some direction, as in a featureless corridor.
-pub fn ambiguity(a: &OccupancyGrid, b: &OccupancyGrid, t_a_b: &Pose2, shift: f64) -> f64 {
-    let walls_b: Vec<Point2<f64>> = (0..b.height())
-        .flat_map(|iy| (0..b.width()).map(move |ix| (ix, iy)))
-        .filter(|&(ix, iy)| b.state(ix, iy) == CellState::Occupied)
-        .map(|(ix, iy)| b.cell_center(ix as i64, iy as i64))
-        .collect();
-    let (_, here) = wall_hits(a, &walls_b, t_a_b);
+pub fn ambiguity(a: &OccupancyGrid, walls_b: &[Point2<f64>], t_a_b: &Pose2, shift: f64) -> f64 {
+    let (_, here) = wall_hits(a, walls_b, t_a_b);
     if here == 0 {
         return 1.0;
     }
@@ -145,7 +141,7 @@ pub fn ambiguity(a: &OccupancyGrid, b: &OccupancyGrid, t_a_b: &Pose2, shift: f64
         .map(|k| {
             let ang = k as f64 * std::f64::consts::FRAC_PI_4;
             let slid = t_a_b * Translation2::new(shift * ang.cos(), shift * ang.sin());
-            wall_hits(a, &walls_b, &slid).1 as f64 / here as f64
+            wall_hits(a, walls_b, &slid).1 as f64 / here as f64
         })
         .fold(0.0, f64::max)
 }
@@ -221,8 +217,9 @@ mod tests {
                 }
             }
         }
-        assert!(ambiguity(&corridor, &corridor, &Pose2::identity(), 1.0) > 0.85);
-        assert!(ambiguity(&room, &room, &Pose2::identity(), 1.0) < 0.6);
+        let (cw, rw) = (crate::refine::wall_points(&corridor), crate::refine::wall_points(&room));
+        assert!(ambiguity(&corridor, &cw, &Pose2::identity(), 1.0) > 0.85);
+        assert!(ambiguity(&room, &rw, &Pose2::identity(), 1.0) < 0.6);
     }
 
     #[test]
