@@ -51,6 +51,8 @@ fn bad_scenarios_name_file_line_and_field() {
     assert_refused(&p, &["key.toml:", "unknown field `turbo`"]);
     let p = variant(d, "model.toml", "model = \"prawn\"", "model = \"roomba\"");
     assert_refused(&p, &["model.toml:", "robots[1].model", "roomba"]);
+    let p = variant(d, "cand.toml", "host = \"experia\"\n", "host = \"experia\"\ncandidates = 0\n");
+    assert_refused(&p, &["cand.toml:", "merge.candidates", "must lie in 1..=16, got 0"]);
 }
 
 #[test]

@@ -37,6 +37,15 @@ pub struct MergeArgs {
     /// Keep only mutual nearest-neighbour matches.
     #[arg(long)]
     pub mutual: bool,
+    /// Candidates per feature: 1 = nearest neighbour with the ratio test (the paper); k > 1 = the k nearest.
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=16))]
+    pub candidates: u32,
+    /// Transforms handed to verification, strongest first (sequential RANSAC); 1 = the paper's single answer.
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=16))]
+    pub hypotheses: u32,
+    /// Grow occupied cells by this many cells before SIFT (0 = the map as it is).
+    #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u32).range(0..=4))]
+    pub wall_dilation: u32,
     /// Map-to-image encoding: `walls` (free and unknown alike) or `paper` (unknown grey).
     #[arg(long, default_value = "walls", value_parser = ["walls", "paper"])]
     pub encoding: String,
@@ -60,7 +69,14 @@ pub fn run(args: MergeArgs) -> Result<ExitCode> {
     let b = map_io::read_ros_map(&args.b)?;
     let mut params = SiftMergerParams {
         model: args.model,
-        matching: MatchParams { ratio: args.ratio, mutual: args.mutual, parallel: true },
+        matching: MatchParams {
+            ratio: args.ratio,
+            mutual: args.mutual,
+            parallel: true,
+            candidates: args.candidates as usize,
+        },
+        wall_dilation: args.wall_dilation as usize,
+        hypotheses: args.hypotheses as usize,
         encoding: if args.encoding == "paper" { MapEncoding::PAPER } else { MapEncoding::WALLS },
         ..Default::default()
     };

@@ -271,6 +271,37 @@ pub fn estimate(model: Model, a: &[Point2<f64>], b: &[Point2<f64>], p: &RansacPa
     Some(Estimate { model, matrix: m, inliers, iterations })
 }
 
+/// Up to `count` distinct transforms by sequential RANSAC: each round removes the previous winners' inliers.
+///
+/// The first is [`estimate`]'s answer. Self-similar maps (a corridor) give a wrong transform more support
+/// than the right one; the later rounds keep the right one in play for verification to pick.
+pub fn estimate_many(
+    model: Model,
+    a: &[Point2<f64>],
+    b: &[Point2<f64>],
+    p: &RansacParams,
+    count: usize,
+) -> Vec<Estimate> {
+    let mut out: Vec<Estimate> = Vec::new();
+    let mut left: Vec<usize> = (0..a.len()).collect();
+    for round in 0..count {
+        let (ra, rb): (Vec<_>, Vec<_>) = left.iter().map(|&i| (a[i], b[i])).unzip();
+        let Some(mut e) = estimate(model, &ra, &rb, &RansacParams { seed: p.seed.wrapping_add(round as u64), ..*p })
+        else {
+            break;
+        };
+        // Too small a consensus to be worth verifying: the remaining matches hold nothing more.
+        if e.inliers.len() <= model.sample_size() {
+            break;
+        }
+        e.inliers = e.inliers.iter().map(|&i| left[i]).collect();
+        let taken: std::collections::BTreeSet<usize> = e.inliers.iter().copied().collect();
+        left.retain(|i| !taken.contains(i));
+        out.push(e);
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -328,6 +359,20 @@ mod tests {
         let p = Point2::new(1.0, 1.0);
         assert!(estimate(Model::Rigid, &[p], &[p], &RansacParams::default()).is_none());
         assert!(estimate(Model::Homography, &[p; 6], &[p; 6], &RansacParams::default()).is_none());
+    }
+
+    #[test]
+    fn sequential_rounds_find_a_weaker_second_transform() {
+        let (t1, t2) = (pose(3.0, -1.5, 0.7), pose(-4.0, 2.0, -2.2));
+        let (mut a, mut b) = scene(&t1, 1.0, 30, 20, 5);
+        let (a2, b2) = scene(&t2, 1.0, 15, 0, 6);
+        a.extend(a2);
+        b.extend(b2);
+        let many = estimate_many(Model::Rigid, &a, &b, &RansacParams::default(), 3);
+        assert!(many.len() >= 2);
+        let angle = |e: &Estimate| e.rigid().rotation.angle();
+        assert!((angle(&many[0]) - 0.7).abs() < 0.01 && (angle(&many[1]) + 2.2).abs() < 0.01);
+        assert!(many[1].inliers.iter().all(|&i| i >= 50) && many[1].inliers.len() >= 14);
     }
 
     #[test]

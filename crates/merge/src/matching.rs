@@ -23,11 +23,22 @@ pub struct MatchParams {
     pub mutual: bool,
     /// Spread the queries over threads.
     pub parallel: bool,
+    /// Candidates kept per feature: 1 is Lowe's nearest neighbour with the ratio test (the paper); k > 1
+    /// keeps the k nearest neighbours without it and leaves the choice to geometric consensus.
+    ///
+    /// Maps drawn by different lidars give the same corner different descriptors: on the paper corridor the
+    /// true partner is the nearest for few keypoints but among the four nearest for half of them.
+    #[serde(default = "one")]
+    pub candidates: usize,
+}
+
+fn one() -> usize {
+    1
 }
 
 impl Default for MatchParams {
     fn default() -> Self {
-        MatchParams { ratio: 0.75, mutual: false, parallel: false }
+        MatchParams { ratio: 0.75, mutual: false, parallel: false, candidates: 1 }
     }
 }
 
@@ -58,12 +69,38 @@ fn two_nearest(q: &[u8], set: &[u8]) -> (usize, u32, u32) {
     (bi, b1, b2)
 }
 
-/// Matches every feature of `a` to its nearest neighbour in `b` that passes the ratio test.
+/// The `k` nearest descriptors of `set` to `q` as (index, squared distance), nearest first.
+fn k_nearest(q: &[u8], set: &[u8], k: usize, out: &mut Vec<(usize, u32)>) {
+    out.clear();
+    for (i, d) in set.chunks_exact(DESCRIPTOR_LEN).enumerate() {
+        let s = dist2(q, d);
+        if out.len() < k || s < out[out.len() - 1].1 {
+            let at = out.partition_point(|&(_, e)| e <= s);
+            out.insert(at, (i, s));
+            out.truncate(k);
+        }
+    }
+}
+
+/// Matches every feature of `a` to its nearest neighbour in `b` that passes the ratio test, or, with
+/// `candidates` > 1, to its k nearest neighbours.
 ///
-/// Results are ordered by index in `a`, so they do not depend on thread scheduling.
+/// Results are ordered by index in `a` (then by distance), so they do not depend on thread scheduling.
 pub fn match_features(a: &Features, b: &Features, p: &MatchParams) -> Vec<Match> {
     if a.is_empty() || b.len() < 2 {
         return Vec::new();
+    }
+    if p.candidates > 1 {
+        let query = |i: usize| -> Vec<Match> {
+            let mut near = Vec::with_capacity(p.candidates + 1);
+            k_nearest(a.descriptor(i), &b.descriptors, p.candidates, &mut near);
+            near.iter().map(|&(j, d)| Match { a: i, b: j, distance: (d as f32).sqrt() }).collect()
+        };
+        return if p.parallel {
+            (0..a.len()).into_par_iter().flat_map_iter(query).collect()
+        } else {
+            (0..a.len()).flat_map(query).collect()
+        };
     }
     let ratio2 = (p.ratio as f64).powi(2);
     let query = |i: usize| -> Option<Match> {
@@ -112,9 +149,21 @@ mod tests {
     fn mutual_check_and_parallel_agree() {
         let a = features(&[[10, 0, 0, 0], [200, 0, 0, 0], [0, 90, 0, 0]]);
         let b = features(&[[12, 0, 0, 0], [0, 90, 0, 0], [100, 100, 100, 100]]);
-        let serial = match_features(&a, &b, &MatchParams { ratio: 0.9, mutual: true, parallel: false });
-        let par = match_features(&a, &b, &MatchParams { ratio: 0.9, mutual: true, parallel: true });
+        let p = MatchParams { ratio: 0.9, mutual: true, ..Default::default() };
+        let serial = match_features(&a, &b, &p);
+        let par = match_features(&a, &b, &MatchParams { parallel: true, ..p });
         assert_eq!(serial, par);
         assert!(serial.iter().all(|m| (m.a, m.b) == (0, 0) || (m.a, m.b) == (2, 1)));
+    }
+
+    #[test]
+    fn k_candidates_are_the_k_nearest_in_order() {
+        let a = features(&[[10, 0, 0, 0], [0, 50, 0, 0]]);
+        let b = features(&[[0, 50, 1, 0], [11, 0, 0, 0], [0, 51, 0, 0], [40, 0, 0, 0]]);
+        let p = MatchParams { candidates: 2, ..Default::default() };
+        let m: Vec<(usize, usize)> = match_features(&a, &b, &p).iter().map(|m| (m.a, m.b)).collect();
+        // a1 keeps both of its equally near partners, which the ratio test would drop
+        assert_eq!(m, vec![(0, 1), (0, 3), (1, 0), (1, 2)]);
+        assert_eq!(match_features(&a, &b, &MatchParams { parallel: true, ..p }).len(), 4);
     }
 }

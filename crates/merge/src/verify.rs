@@ -157,7 +157,10 @@ pub fn rejection_reason(p: &VerifyParams, inliers: usize, matches: usize, agreem
     if inliers < p.min_inliers {
         Some(format!("only {inliers} inlier matches (need {})", p.min_inliers))
     } else if conf < p.min_confidence {
-        Some(format!("confidence {conf:.2} below {:.2} ({inliers} inliers of {matches} matches)", p.min_confidence))
+        Some(format!(
+            "confidence {conf:.2} below {:.2} ({inliers} inliers, {matches} features matched)",
+            p.min_confidence
+        ))
     } else if agreement.common() < p.min_common_cells {
         Some(format!("aligned maps share only {} known cells (need {})", agreement.common(), p.min_common_cells))
     } else if agreement.wall_agreement() < p.min_wall_agreement {

@@ -56,6 +56,30 @@ fn never_accepts_pairs_with_nothing_in_common() {
 }
 
 #[test]
+fn robust_setting_merges_more_at_low_overlap_and_still_never_wrongly() {
+    // Calibration (40 pairs each, `calibrate 40 robust`): overlap 0.2 -> 39/40 correct, gap -> 0 accepted;
+    // the paper's setting gets 35/40 at 0.2.
+    let merger = SiftMerger::new(SiftMergerParams::robust());
+    let res = FloorplanParams::default().resolution;
+    let outcomes: Vec<(bool, bool, bool)> = (0..20u64)
+        .into_par_iter()
+        .map(|s| {
+            let p = pair(s, 0.2);
+            let out = merge(&merger, &p.a, &p.b, &MergeParams::default());
+            let ok = errors(&out, &p.t_a_b).is_some_and(|(r, t)| r <= 1f64.to_radians() && t <= 2.0 * res);
+            let gap = pair(s, -0.1);
+            let gap_accepted = merge(&merger, &gap.a, &gap.b, &MergeParams::default()).report.accepted;
+            (out.report.accepted && ok, out.report.accepted && !ok, gap_accepted)
+        })
+        .collect();
+    let good = outcomes.iter().filter(|o| o.0).count();
+    let wrong = outcomes.iter().filter(|o| o.1).count();
+    let gap = outcomes.iter().filter(|o| o.2).count();
+    assert!(good >= 18, "only {good}/20 at overlap 0.2");
+    assert_eq!((wrong, gap), (0, 0), "wrong merges accepted: {wrong} at overlap 0.2, {gap} of 20 gap pairs");
+}
+
+#[test]
 fn map_rotated_30_degrees_against_itself() {
     let map = generate(5, &FloorplanParams::default());
     let t_b_a = pose(1.3, -0.7, 30f64.to_radians());

@@ -68,7 +68,9 @@ pub fn merger_for(name: &str, scenario: &Scenario) -> Result<Box<dyn Merger>, Ru
             let mut p = SiftMergerParams {
                 model: m.model,
                 encoding: m.encoding,
-                matching: MatchParams { ratio: m.ratio, ..MatchParams::default() },
+                matching: MatchParams { ratio: m.ratio, candidates: m.candidates, ..MatchParams::default() },
+                hypotheses: m.hypotheses,
+                wall_dilation: m.wall_dilation,
                 ..SiftMergerParams::default()
             };
             p.ransac.seed = scenario.seed;

@@ -85,6 +85,12 @@ pub struct MergeSetup {
     pub ratio: f32,
     /// Map-to-image encoding.
     pub encoding: MapEncoding,
+    /// Descriptor candidates per feature (1: nearest neighbour with the ratio test, as the paper).
+    pub candidates: usize,
+    /// Transforms handed to verification (1: the paper's single answer).
+    pub hypotheses: usize,
+    /// Cells by which walls grow before SIFT.
+    pub wall_dilation: usize,
     /// Robot that hosts the merge (the paper: Experia); the other's map is merged into its frame.
     pub host: String,
 }
@@ -254,6 +260,9 @@ struct MergeFile {
     model: Option<String>,
     ratio: Option<f32>,
     encoding: Option<String>,
+    candidates: Option<usize>,
+    hypotheses: Option<usize>,
+    wall_dilation: Option<usize>,
     host: Option<String>,
 }
 
@@ -642,5 +651,14 @@ fn resolve_merge(cx: &Ctx, m: &MergeFile, robots: &[RobotSetup], duration: f64) 
     if !robots.iter().any(|r| r.name == host) {
         return Err(cx.err("merge.host", &host, format!("no robot named `{host}`")));
     }
-    Ok(MergeSetup { when, algorithms, model, ratio, encoding, host })
+    let in_range = |field: &str, v: Option<usize>, lo: usize, hi: usize, default: usize| match v {
+        Some(x) if !(lo..=hi).contains(&x) => {
+            Err(cx.err(field, field.trim_start_matches("merge."), format!("must lie in {lo}..={hi}, got {x}")))
+        }
+        v => Ok(v.unwrap_or(default)),
+    };
+    let candidates = in_range("merge.candidates", m.candidates, 1, 16, 1)?;
+    let hypotheses = in_range("merge.hypotheses", m.hypotheses, 1, 16, 1)?;
+    let wall_dilation = in_range("merge.wall_dilation", m.wall_dilation, 0, 4, 0)?;
+    Ok(MergeSetup { when, algorithms, model, ratio, encoding, candidates, hypotheses, wall_dilation, host })
 }

@@ -333,7 +333,16 @@ impl RmapMerger {
         };
         timings.insert("transform".to_string(), ms(t));
         Ok(RmapResult {
-            alignment: Alignment { transform: t_ab, scale, matches, inliers, timings_ms: timings, evidence },
+            alignment: Alignment {
+                transform: t_ab,
+                scale,
+                matches,
+                matched_features: matches,
+                inliers,
+                timings_ms: timings,
+                evidence,
+                alternatives: Vec::new(),
+            },
             angles: (th_a, th_b),
             triangles: found,
             scale_iterations: iterations,
