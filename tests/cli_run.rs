@@ -53,6 +53,10 @@ fn bad_scenarios_name_file_line_and_field() {
     assert_refused(&p, &["model.toml:", "robots[1].model", "roomba"]);
     let p = variant(d, "cand.toml", "host = \"experia\"\n", "host = \"experia\"\ncandidates = 0\n");
     assert_refused(&p, &["cand.toml:", "merge.candidates", "must lie in 1..=16, got 0"]);
+    let p = variant(d, "slam.toml", "speed = 0.3\n", "speed = 0.3\nslam = { preset = \"rplidar\", warp = 9 }\n");
+    assert_refused(&p, &["slam.toml:", "robots[1].slam.warp", "unknown SLAM parameter 'warp'"]);
+    let p = variant(d, "slam2.toml", "speed = 0.3\n", "speed = 0.3\nslam = { particles = \"many\" }\n");
+    assert_refused(&p, &["slam2.toml:", "robots[1].slam.particles", "many"]);
 }
 
 #[test]

@@ -9,6 +9,7 @@ use mrslam_sim::{EncoderParams, LidarModel, RobotModel, SlipParams, World, World
 use mrslam_slam::SlamParams;
 use nalgebra::Point2;
 use serde::Deserialize;
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 /// A scenario error, naming the file, line and field.
@@ -209,27 +210,12 @@ struct EncoderFile {
     wheel_base_error: Option<f64>,
 }
 
+/// A robot's `slam` table: an optional `preset`, then any parameter of [`SlamParams::set`] by name.
 #[derive(Deserialize, Default)]
-#[serde(deny_unknown_fields)]
 struct SlamFile {
     preset: Option<String>,
-    particles: Option<usize>,
-    delta: Option<f64>,
-    linear_update: Option<f64>,
-    angular_update: Option<f64>,
-    resample_threshold: Option<f64>,
-    sigma: Option<f64>,
-    lsigma: Option<f64>,
-    ogain: Option<f64>,
-    lstep: Option<f64>,
-    astep: Option<f64>,
-    iterations: Option<u32>,
-    lskip: Option<usize>,
-    minimum_score: Option<f64>,
-    srr: Option<f64>,
-    srt: Option<f64>,
-    str: Option<f64>,
-    stt: Option<f64>,
+    #[serde(flatten)]
+    params: BTreeMap<String, toml::Value>,
 }
 
 #[derive(Deserialize)]
@@ -570,24 +556,21 @@ fn resolve_slam(cx: &Ctx, field: &str, s: &SlamFile, lidar: &LidarModel) -> Resu
         None if lidar.range_max <= 4.5 => SlamParams::hokuyo(),
         None => SlamParams::rplidar(),
     };
-    apply(&mut [(&mut p.particles, s.particles), (&mut p.lskip, s.lskip)]);
-    apply(&mut [(&mut p.iterations, s.iterations)]);
-    apply(&mut [
-        (&mut p.delta, s.delta),
-        (&mut p.linear_update, s.linear_update),
-        (&mut p.angular_update, s.angular_update),
-        (&mut p.resample_threshold, s.resample_threshold),
-        (&mut p.sigma, s.sigma),
-        (&mut p.lsigma, s.lsigma),
-        (&mut p.ogain, s.ogain),
-        (&mut p.lstep, s.lstep),
-        (&mut p.astep, s.astep),
-        (&mut p.minimum_score, s.minimum_score),
-        (&mut p.srr, s.srr),
-        (&mut p.srt, s.srt),
-        (&mut p.str, s.str),
-        (&mut p.stt, s.stt),
-    ]);
+    // Each name sets its own field, so the (sorted) order of application does not matter.
+    for (name, value) in &s.params {
+        let text = match value {
+            toml::Value::String(t) => t.clone(),
+            toml::Value::Integer(_) | toml::Value::Float(_) | toml::Value::Boolean(_) => value.to_string(),
+            other => {
+                return Err(cx.err(
+                    format!("{field}.{name}"),
+                    name,
+                    format!("expected a number, boolean or string, got {other}"),
+                ));
+            }
+        };
+        p.set(name, &text).map_err(|e| cx.err(format!("{field}.{name}"), name, e))?;
+    }
     // The filter sees no farther than the lidar.
     p.max_range = p.max_range.min(lidar.range_max);
     p.max_urange = p.max_urange.min(lidar.range_max);
