@@ -1,5 +1,5 @@
 //! Times N merges of the benchmark's 600x600 pair (for CPU-time measurement with `/usr/bin/time`):
-//! `cargo run --release -p mrslam-merge --example merge_timing -- [N] [upscale]`.
+//! `cargo run --release -p mrslam-merge --example merge_timing -- [N] [up|noup] [paper|robust]`.
 
 use mrslam_merge::floorplan::{FloorplanParams, generate};
 use mrslam_merge::pairs::{PairSpec, cut_pair};
@@ -11,7 +11,8 @@ fn main() {
     let plan = FloorplanParams { width_m: 29.0, height_m: 29.0, ..FloorplanParams::default() };
     let map = generate(7, &plan);
     let pair = cut_pair(&map, &PairSpec { overlap: 0.5, max_shift_m: 2.0, rotate: true }, 7);
-    let mut p = SiftMergerParams::default();
+    let robust = std::env::args().nth(3).is_some_and(|s| s == "robust");
+    let mut p = if robust { SiftMergerParams::robust() } else { SiftMergerParams::default() };
     p.sift.upscale = upscale;
     let merger = SiftMerger::new(p);
     let mut stages = std::collections::BTreeMap::<String, f64>::new();
@@ -22,5 +23,5 @@ fn main() {
             *stages.entry(k.clone()).or_default() += v / n as f64;
         }
     }
-    println!("upscale {upscale}: mean stage ms {stages:?}");
+    println!("upscale {upscale}, robust {robust}: mean stage ms {stages:?}");
 }
