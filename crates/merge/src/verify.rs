@@ -106,25 +106,58 @@ pub fn agreement(a: &OccupancyGrid, b: &OccupancyGrid, t_a_b: &Pose2) -> Agreeme
     r
 }
 
+/// Map a's cells as two bitmaps: known, and "an occupied cell within one cell".
+struct WallIndex {
+    width: usize,
+    height: usize,
+    known: Vec<bool>,
+    near_wall: Vec<bool>,
+}
+
+impl WallIndex {
+    fn of(a: &OccupancyGrid) -> Self {
+        let (w, h) = (a.width(), a.height());
+        let states: Vec<CellState> = a.cells().iter().map(|&l| CellState::from_log_odds(l)).collect();
+        let known = states.iter().map(|&s| s != CellState::Unknown).collect();
+        // Separable 3x3 dilation of the occupied cells: rows, then columns.
+        let mut rows = vec![false; w * h];
+        for y in 0..h {
+            for x in 0..w {
+                let row = &states[y * w..(y + 1) * w];
+                rows[y * w + x] = row[x.saturating_sub(1)..=(x + 1).min(w - 1)].contains(&CellState::Occupied);
+            }
+        }
+        let mut near_wall = vec![false; w * h];
+        for y in 0..h {
+            for x in 0..w {
+                near_wall[y * w + x] = (y.saturating_sub(1)..=(y + 1).min(h - 1)).any(|yy| rows[yy * w + x]);
+            }
+        }
+        WallIndex { width: w, height: h, known, near_wall }
+    }
+
+    /// Walls of b placed by `t_a_b`: (on a's known cells, of those with a wall of a within one cell).
+    fn hits(&self, a: &OccupancyGrid, walls_b: &[Point2<f64>], t_a_b: &Pose2) -> (usize, usize) {
+        let (mut on_known, mut matched) = (0, 0);
+        for p in walls_b {
+            let (ix, iy) = a.world_to_cell_i(&(t_a_b * p));
+            if ix < 0 || iy < 0 || ix >= self.width as i64 || iy >= self.height as i64 {
+                continue;
+            }
+            let i = iy as usize * self.width + ix as usize;
+            if self.known[i] {
+                on_known += 1;
+                matched += self.near_wall[i] as usize;
+            }
+        }
+        (on_known, matched)
+    }
+}
+
 /// Walls of `b` (occupied cell centres, b's frame) placed by `t_a_b`: how many land on a's known cells, and
 /// how many of those have an occupied cell of `a` within one cell.
 pub fn wall_hits(a: &OccupancyGrid, walls_b: &[Point2<f64>], t_a_b: &Pose2) -> (usize, usize) {
-    let (mut on_known, mut matched) = (0, 0);
-    for p in walls_b {
-        let (ix, iy) = a.world_to_cell_i(&(t_a_b * p));
-        let Some(l) = a.get_checked(ix, iy) else { continue };
-        if CellState::from_log_odds(l) == CellState::Unknown {
-            continue;
-        }
-        on_known += 1;
-        let near = (-1..=1).any(|dy| {
-            (-1..=1).any(|dx| {
-                a.get_checked(ix + dx, iy + dy).is_some_and(|l| CellState::from_log_odds(l) == CellState::Occupied)
-            })
-        });
-        matched += near as usize;
-    }
-    (on_known, matched)
+    WallIndex::of(a).hits(a, walls_b, t_a_b)
 }
 
 /// How well the maps still agree when b slides `shift` metres (8 directions, in b's frame) away from `t_a_b`:
@@ -133,7 +166,8 @@ pub fn wall_hits(a: &OccupancyGrid, walls_b: &[Point2<f64>], t_a_b: &Pose2) -> (
 ///
 /// Near 1 means the alignment is not pinned down along some direction, as in a featureless corridor.
 pub fn ambiguity(a: &OccupancyGrid, walls_b: &[Point2<f64>], t_a_b: &Pose2, shift: f64) -> f64 {
-    let (_, here) = wall_hits(a, walls_b, t_a_b);
+    let index = WallIndex::of(a);
+    let (_, here) = index.hits(a, walls_b, t_a_b);
     if here == 0 {
         return 1.0;
     }
@@ -141,7 +175,7 @@ pub fn ambiguity(a: &OccupancyGrid, walls_b: &[Point2<f64>], t_a_b: &Pose2, shif
         .map(|k| {
             let ang = k as f64 * std::f64::consts::FRAC_PI_4;
             let slid = t_a_b * Translation2::new(shift * ang.cos(), shift * ang.sin());
-            wall_hits(a, walls_b, &slid).1 as f64 / here as f64
+            index.hits(a, walls_b, &slid).1 as f64 / here as f64
         })
         .fold(0.0, f64::max)
 }
@@ -223,6 +257,31 @@ mod tests {
         let (cw, rw) = (crate::refine::wall_points(&corridor), crate::refine::wall_points(&room));
         assert!(ambiguity(&corridor, &cw, &Pose2::identity(), 1.0) > 0.85);
         assert!(ambiguity(&room, &rw, &Pose2::identity(), 1.0) < 0.6);
+    }
+
+    #[test]
+    fn wall_hits_match_a_cell_by_cell_count() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
+        let mut a = OccupancyGrid::new(40, 30, 0.1, pose(-1.0, 0.5, 0.2)).unwrap();
+        for l in a.cells_mut() {
+            *l = [-2.0, 0.0, 2.0][rng.random_range(0..3)];
+        }
+        let walls: Vec<Point2<f64>> =
+            (0..500).map(|_| Point2::new(rng.random_range(-2.0..3.0), rng.random_range(0.0..4.0))).collect();
+        let t = pose(0.1, -0.1, 0.3);
+        let state = |ix: i64, iy: i64| a.get_checked(ix, iy).map(CellState::from_log_odds);
+        let (mut known, mut matched) = (0, 0);
+        for p in &walls {
+            let (ix, iy) = a.world_to_cell_i(&(t * p));
+            if state(ix, iy).is_some_and(|s| s != CellState::Unknown) {
+                known += 1;
+                let near = (-1..=1).any(|dy| (-1..=1).any(|dx| state(ix + dx, iy + dy) == Some(CellState::Occupied)));
+                matched += near as usize;
+            }
+        }
+        assert!(known > 100 && matched > 50, "{known} {matched}");
+        assert_eq!(wall_hits(&a, &walls, &t), (known, matched));
     }
 
     #[test]
