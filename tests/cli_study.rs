@@ -167,6 +167,6 @@ fn the_shipped_sweep_file_is_valid() {
     let o = mrslam(&["study", "scenario", sweep.to_str().unwrap(), "--dry-run", "--out", "/nonexistent/never"]);
     ok(&o);
     let stdout = String::from_utf8_lossy(&o.stdout);
-    assert!(stdout.contains("6 trials"), "{stdout}");
+    assert!(stdout.contains("9 trials"), "{stdout}");
     assert!(stdout.contains("experia.route_end_x=34"), "{stdout}");
 }

@@ -32,6 +32,25 @@ fn check_common(r: &RunReport) {
     }
 }
 
+/// The paper's merger succeeds (accepted, within the scenario's 2 deg / 0.3 m of the true relative pose of
+/// the start frames).
+fn assert_sift_succeeds(r: &RunReport) {
+    let m = r.merges.iter().find(|m| m.algorithm == "sift").expect("a sift merge ran");
+    assert!(m.accepted && m.success, "sift merge did not succeed: {m:?}");
+}
+
+/// R-map, honestly: our implementation refuses both paper maps, and nothing wrong gets through.
+///
+/// What we see: the maximal empty rectangles of a SLAM map depend on every stray hit and every unseen cell,
+/// so the two robots' R-maps share few rectangles of similar size; the "common triangles" with the lowest
+/// cost (equation 1) pair unrelated rectangles and imply a scale between the maps of 0.4-5 where the truth is
+/// 1, so the scale loop gives up ("scale ratio ... beyond the allowed 2"). The paper saw R-map fail on the
+/// corridor (its figure 10-11, wrong common triangles); on the floor-plan study it needs overlap ~0.45.
+fn assert_rmap_refuses(r: &RunReport) {
+    let m = r.merges.iter().find(|m| m.algorithm == "rmap").expect("an rmap merge ran");
+    assert!(!m.accepted, "rmap accepted: {m:?}");
+}
+
 #[test]
 fn paper_corridor_maps_well_and_never_merges_wrongly() {
     let r = run_paper("paper_corridor");
@@ -45,15 +64,19 @@ fn paper_corridor_maps_well_and_never_merges_wrongly() {
         );
         assert!(robot.map_acceptance > 0.95, "{name}: map acceptance {:.3}", robot.map_acceptance);
     }
-    // Not yet: the SIFT merge of the two corridor halves. The halves overlap over ~8 m of a corridor whose
-    // door recesses repeat, and the merger finds 3-6 consistent matches; the gate rejects it (see the run's
-    // report). The paper's claim is that it succeeds; issue [testbed] stays open until it does here.
+    assert_sift_succeeds(&r);
+    assert_rmap_refuses(&r);
 }
 
 #[test]
 fn paper_two_rooms_runs_and_never_merges_wrongly() {
     let r = run_paper("paper_two_rooms");
     check_common(&r);
-    let experia = &r.robots["experia"];
-    assert!(experia.slam_rmse_m < 0.5 * experia.odom_rmse_m, "{experia:?}");
+    for (name, robot) in &r.robots {
+        assert!(robot.slam_rmse_m < 0.5 * robot.odom_rmse_m, "{name}: {robot:?}");
+    }
+    // Not yet: the SIFT merge here. With this SLAM, Prawn's map of the east room is bent (acceptance index
+    // against the truth ~0.87) and the merge is refused by the gate (its walls miss a's); the test holds the
+    // line that nothing wrong is accepted. Issue [testbed] stays open until it succeeds.
+    assert_rmap_refuses(&r);
 }
