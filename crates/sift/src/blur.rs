@@ -6,6 +6,7 @@
 //! copy compiled for AVX2 is picked at run time. No fused multiply-add is used, so both copies give
 //! bit-identical results.
 
+use crate::mask::{CHUNK, ChunkMask, ChunkRuns};
 use rayon::prelude::*;
 
 /// Columns processed together in registers (enough independent accumulators to hide add latency).
@@ -18,6 +19,13 @@ const LANES: usize = 32;
 pub struct Kernel {
     /// Centre weight first, then the weights of offsets 1, 2, ... (normalised: full kernel sums to 1).
     pub half: Vec<f32>,
+}
+
+impl Default for Kernel {
+    /// The identity (a single weight 1).
+    fn default() -> Self {
+        Kernel { half: vec![1.0] }
+    }
 }
 
 impl Kernel {
@@ -59,25 +67,104 @@ pub fn reflect101(mut i: isize, n: usize) -> usize {
     }
 }
 
-/// Blurs `src` (`w` x `h`, row-major) into `dst` with `kernel`; `row_buf` is scratch (resized as needed).
-/// With `parallel`, bands of rows are spread over the rayon pool (same result).
-pub fn blur(src: &[f32], dst: &mut [f32], w: usize, h: usize, kernel: &Kernel, row_buf: &mut Vec<f32>, parallel: bool) {
+/// Output rows blurred together: the vertical pass of a group runs strip by strip so the input rows it
+/// reads stay in the L1 cache.
+const GROUP: usize = 16;
+/// Columns of one strip of the vertical pass.
+const STRIP: usize = 256;
+
+/// Where a blur has to compute (see `mask`): outside `vert` the vertical pass sees one constant down its
+/// whole window, outside `out` the horizontal pass does across its window. Both are chunk masks of the
+/// output image with offset 0.
+#[derive(Debug, Clone, Copy)]
+pub struct Sparse<'a> {
+    /// Chunks where the vertical pass must compute.
+    pub vert: &'a ChunkMask,
+    /// Chunks where the output must be computed.
+    pub out: &'a ChunkMask,
+}
+
+/// Reusable buffers of the blur.
+#[derive(Debug, Default, Clone)]
+pub struct BlurScratch {
+    /// Vertical-pass rows of one group, each padded by the kernel radius on both sides.
+    vbuf: Vec<f32>,
+    /// Per group row, offsets of the source rows of the vertical window.
+    rows: Vec<usize>,
+    /// Chunk bits of the rows of one quad.
+    spans_u64: Vec<u64>,
+}
+
+/// The blur of a constant image `c`: exactly what both passes compute for a constant window
+/// (`k0 c`, then `+= k_i (c + c)` for i = 1..r, the same operations in the same order).
+#[inline]
+pub fn constant(kernel: &Kernel, c: f32) -> f32 {
+    let k = &kernel.half[..];
+    let mut acc = k[0] * c;
+    for &ki in &k[1..] {
+        acc += ki * (c + c);
+    }
+    acc
+}
+
+/// Remembers the last few constants blurred (an image has few distinct flat levels).
+struct ConstCache<'a> {
+    kernel: &'a Kernel,
+    keys: [u32; 4],
+    vals: [f32; 4],
+    len: usize,
+    next: usize,
+}
+
+impl<'a> ConstCache<'a> {
+    fn new(kernel: &'a Kernel) -> Self {
+        Self { kernel, keys: [0; 4], vals: [0.0; 4], len: 0, next: 0 }
+    }
+
+    #[inline]
+    fn get(&mut self, c: f32) -> f32 {
+        let b = c.to_bits();
+        for i in 0..self.len {
+            if self.keys[i] == b {
+                return self.vals[i];
+            }
+        }
+        let v = constant(self.kernel, c);
+        self.keys[self.next] = b;
+        self.vals[self.next] = v;
+        self.next = (self.next + 1) % 4;
+        self.len = (self.len + 1).min(4);
+        v
+    }
+}
+
+/// Blurs `src` (`w` x `h`, row-major) into `dst` with `kernel`; `scratch` is reused. With `parallel`,
+/// bands of rows are spread over the rayon pool; with `sparse`, only the masked chunks are computed and
+/// the others are filled with their constant. Same result every way, bit for bit.
+#[allow(clippy::too_many_arguments)]
+pub fn blur(
+    src: &[f32],
+    dst: &mut [f32],
+    w: usize,
+    h: usize,
+    kernel: &Kernel,
+    scratch: &mut BlurScratch,
+    parallel: bool,
+    sparse: Option<Sparse<'_>>,
+) {
     let n = w * h;
     if n == 0 {
         return;
     }
     let (src, dst) = (&src[..n], &mut dst[..n]);
-    let r = kernel.radius();
     if parallel && h >= 64 {
         let band = h.div_ceil(rayon::current_num_threads().max(1) * 4).max(8);
         dst.par_chunks_mut(band * w).enumerate().for_each(|(b, chunk)| {
-            let mut buf = vec![0.0f32; w + 2 * r];
-            let y0 = b * band;
-            blur_rows(src, chunk, w, h, y0, kernel, &mut buf);
+            let mut s = BlurScratch::default();
+            blur_rows(src, chunk, w, h, b * band, kernel, &mut s, sparse);
         });
     } else {
-        row_buf.resize(w + 2 * r, 0.0);
-        blur_rows(src, dst, w, h, 0, kernel, row_buf);
+        blur_rows(src, dst, w, h, 0, kernel, scratch, sparse);
     }
 }
 
@@ -92,46 +179,184 @@ pub fn blur_band(
     y0: usize,
     y1: usize,
     kernel: &Kernel,
-    row_buf: &mut Vec<f32>,
+    scratch: &mut BlurScratch,
+    sparse: Option<Sparse<'_>>,
 ) {
     if w == 0 || y0 >= y1 {
         return;
     }
-    row_buf.resize(w + 2 * kernel.radius(), 0.0);
-    blur_rows(&src[..w * h], &mut dst[y0 * w..y1 * w], w, h, y0, kernel, row_buf);
+    blur_rows(&src[..w * h], &mut dst[y0 * w..y1 * w], w, h, y0, kernel, scratch, sparse);
 }
 
 /// Blurs output rows `y0 .. y0 + out.len() / w` into `out`.
-fn blur_rows(src: &[f32], out: &mut [f32], w: usize, h: usize, y0: usize, kernel: &Kernel, buf: &mut [f32]) {
+#[allow(clippy::too_many_arguments)]
+fn blur_rows(
+    src: &[f32],
+    out: &mut [f32],
+    w: usize,
+    h: usize,
+    y0: usize,
+    kernel: &Kernel,
+    s: &mut BlurScratch,
+    sparse: Option<Sparse<'_>>,
+) {
     #[cfg(target_arch = "x86_64")]
     {
         if std::arch::is_x86_feature_detected!("avx512f") {
             // SAFETY: the CPU supports AVX-512F (checked just above).
-            unsafe { blur_rows_avx512(src, out, w, h, y0, kernel, buf) };
+            unsafe { blur_rows_avx512(src, out, w, h, y0, kernel, s, sparse) };
             return;
         }
         if std::arch::is_x86_feature_detected!("avx2") {
             // SAFETY: the CPU supports AVX2 (checked just above).
-            unsafe { blur_rows_avx2(src, out, w, h, y0, kernel, buf) };
+            unsafe { blur_rows_avx2(src, out, w, h, y0, kernel, s, sparse) };
             return;
         }
     }
-    blur_rows_impl::<LANES>(src, out, w, h, y0, kernel, buf);
+    blur_rows_impl::<LANES>(src, out, w, h, y0, kernel, s, sparse);
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-fn blur_rows_avx2(src: &[f32], out: &mut [f32], w: usize, h: usize, y0: usize, kernel: &Kernel, buf: &mut [f32]) {
-    blur_rows_impl::<LANES>(src, out, w, h, y0, kernel, buf);
+#[allow(clippy::too_many_arguments)]
+fn blur_rows_avx2(
+    src: &[f32],
+    out: &mut [f32],
+    w: usize,
+    h: usize,
+    y0: usize,
+    kernel: &Kernel,
+    s: &mut BlurScratch,
+    sparse: Option<Sparse<'_>>,
+) {
+    blur_rows_impl::<LANES>(src, out, w, h, y0, kernel, s, sparse);
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f")]
-fn blur_rows_avx512(src: &[f32], out: &mut [f32], w: usize, h: usize, y0: usize, kernel: &Kernel, buf: &mut [f32]) {
-    blur_rows_impl::<LANES_AVX512>(src, out, w, h, y0, kernel, buf);
+#[allow(clippy::too_many_arguments)]
+fn blur_rows_avx512(
+    src: &[f32],
+    out: &mut [f32],
+    w: usize,
+    h: usize,
+    y0: usize,
+    kernel: &Kernel,
+    s: &mut BlurScratch,
+    sparse: Option<Sparse<'_>>,
+) {
+    blur_rows_impl::<LANES_AVX512>(src, out, w, h, y0, kernel, s, sparse);
+}
+
+/// Rows computed together: with [`CHUNK`] columns each, enough independent accumulator chains to hide
+/// the add latency, whatever the width of the active spans.
+const QUAD: usize = 4;
+
+/// Vertical pass of [`CHUNK`] columns at `x` for four output rows (`rows[j]`: the source row offsets of
+/// output row `j`, centre first, then above / below pairs): `k0 c + sum_i k_i (above_i + below_i)`.
+///
+/// # Safety
+/// Each `rows[j]` holds at least `2 k.len() - 1` offsets, and every offset plus `x + CHUNK` is at most
+/// `src.len()`. (The loop runs once per tap and row: bounds checks there would cost as much as the
+/// arithmetic.)
+#[inline(always)]
+#[allow(clippy::needless_range_loop)]
+unsafe fn vquad(src: &[f32], rows: [&[usize]; QUAD], k: &[f32], x: usize) -> [[f32; CHUNK]; QUAD] {
+    let p = src.as_ptr();
+    // SAFETY (all blocks below): offsets are in bounds by the caller's contract; `CHUNK` f32 values from
+    // an in-bounds offset form a valid `[f32; CHUNK]` (f32 has alignment 4, `p` is a slice pointer).
+    let at = |o: usize| unsafe { &*(p.add(o + x) as *const [f32; CHUNK]) };
+    let mut acc = [[0.0f32; CHUNK]; QUAD];
+    for j in 0..QUAD {
+        let c = at(unsafe { *rows[j].get_unchecked(0) });
+        for l in 0..CHUNK {
+            acc[j][l] = k[0] * c[l];
+        }
+    }
+    for i in 1..k.len() {
+        let ki = k[i];
+        for j in 0..QUAD {
+            let (a, b) = unsafe { (at(*rows[j].get_unchecked(2 * i - 1)), at(*rows[j].get_unchecked(2 * i))) };
+            for l in 0..CHUNK {
+                acc[j][l] += ki * (a[l] + b[l]);
+            }
+        }
+    }
+    acc
+}
+
+/// Horizontal pass of [`CHUNK`] outputs at `x` for four padded rows (`bufs[j]`: column `x` at `r + x`).
+///
+/// # Safety
+/// Every `bufs[j]` holds at least `x + 2 r + CHUNK` values (`r = k.len() - 1`).
+#[inline(always)]
+#[allow(clippy::needless_range_loop)]
+unsafe fn hquad(bufs: [&[f32]; QUAD], k: &[f32], x: usize) -> [[f32; CHUNK]; QUAD] {
+    let r = k.len() - 1;
+    // SAFETY: offsets up to `x + 2 r` plus `CHUNK` values are in bounds by the caller's contract.
+    let at = |j: usize, o: usize| unsafe { &*(bufs[j].as_ptr().add(o) as *const [f32; CHUNK]) };
+    let mut acc = [[0.0f32; CHUNK]; QUAD];
+    for j in 0..QUAD {
+        let c = at(j, r + x);
+        for l in 0..CHUNK {
+            acc[j][l] = k[0] * c[l];
+        }
+    }
+    for i in 1..=r {
+        let ki = k[i];
+        for j in 0..QUAD {
+            let (a, b) = (at(j, r + x - i), at(j, r + x + i));
+            for l in 0..CHUNK {
+                acc[j][l] += ki * (a[l] + b[l]);
+            }
+        }
+    }
+    acc
+}
+
+/// Vertical pass of one column (narrow images).
+#[inline(always)]
+fn vpixel(src: &[f32], rows: &[usize], k: &[f32], x: usize) -> f32 {
+    let mut acc = k[0] * src[rows[0] + x];
+    for i in 1..k.len() {
+        acc += k[i] * (src[rows[2 * i - 1] + x] + src[rows[2 * i] + x]);
+    }
+    acc
+}
+
+/// Horizontal pass of one output (narrow images).
+#[inline(always)]
+fn hpixel(buf: &[f32], k: &[f32], x: usize) -> f32 {
+    let r = k.len() - 1;
+    let mut acc = k[0] * buf[r + x];
+    for i in 1..=r {
+        acc += k[i] * (buf[r + x - i] + buf[r + x + i]);
+    }
+    acc
+}
+
+/// Column span `[a, b)` of chunks `[ca, cb)` of a row of width `w`.
+#[inline]
+fn cols(ca: usize, cb: usize, w: usize) -> (usize, usize) {
+    (ca * CHUNK, (cb * CHUNK).min(w))
+}
+
+/// Column of the block computing chunk `c`: the chunk itself, or for a partial last chunk the last
+/// [`CHUNK`] columns of the row (recomputing a few columns gives them their own values again).
+#[inline]
+fn block_x(c: usize, w: usize) -> usize {
+    (c * CHUNK).min(w - CHUNK)
+}
+
+/// Row indices (within the group) of quad `q` of a group of `gn` rows; a short last quad repeats its
+/// last row (computed twice, same values).
+#[inline]
+fn quad_rows(q: usize, gn: usize) -> [usize; QUAD] {
+    std::array::from_fn(|j| (q * QUAD + j).min(gn - 1))
 }
 
 #[inline(always)]
+#[allow(clippy::too_many_arguments)]
 fn blur_rows_impl<const LANES: usize>(
     src: &[f32],
     out: &mut [f32],
@@ -139,79 +364,174 @@ fn blur_rows_impl<const LANES: usize>(
     h: usize,
     y0: usize,
     kernel: &Kernel,
-    buf: &mut [f32],
+    s: &mut BlurScratch,
+    sparse: Option<Sparse<'_>>,
 ) {
     let k = &kernel.half[..];
     let r = k.len() - 1;
-    let k0 = k[0];
-    let mut above: Vec<usize> = vec![0; r + 1];
-    let mut below: Vec<usize> = vec![0; r + 1];
-    for (dy, out_row) in out.chunks_exact_mut(w).enumerate() {
-        let y = y0 + dy;
-        for i in 1..=r {
-            above[i] = reflect101(y as isize - i as isize, h) * w;
-            below[i] = reflect101((y + i) as isize, h) * w;
-        }
-        // Vertical pass into buf[r .. r + w].
-        let centre = &src[y * w..y * w + w];
-        let inner = &mut buf[r..r + w];
-        let mut x = 0;
-        while x + LANES <= w {
-            let mut acc = [0.0f32; LANES];
-            let c = &centre[x..x + LANES];
-            for l in 0..LANES {
-                acc[l] = k0 * c[l];
-            }
-            for i in 1..=r {
-                let a = &src[above[i] + x..above[i] + x + LANES];
-                let b = &src[below[i] + x..below[i] + x + LANES];
-                let ki = k[i];
-                for l in 0..LANES {
-                    acc[l] += ki * (a[l] + b[l]);
-                }
-            }
-            inner[x..x + LANES].copy_from_slice(&acc);
-            x += LANES;
-        }
-        for x in x..w {
-            let mut acc = k0 * centre[x];
-            for i in 1..=r {
-                acc += k[i] * (src[above[i] + x] + src[below[i] + x]);
-            }
-            inner[x] = acc;
-        }
-        // Reflect-101 padding of the vertical result.
-        for j in 1..=r {
-            buf[r - j] = buf[r + reflect101(-(j as isize), w)];
-            buf[r + w - 1 + j] = buf[r + reflect101((w - 1 + j) as isize, w)];
-        }
-        // Horizontal pass.
-        let mut x = 0;
-        while x + LANES <= w {
-            let mut acc = [0.0f32; LANES];
-            let c = &buf[r + x..r + x + LANES];
-            for l in 0..LANES {
-                acc[l] = k0 * c[l];
-            }
-            for i in 1..=r {
-                let a = &buf[r + x - i..r + x - i + LANES];
-                let b = &buf[r + x + i..r + x + i + LANES];
-                let ki = k[i];
-                for l in 0..LANES {
-                    acc[l] += ki * (a[l] + b[l]);
-                }
-            }
-            out_row[x..x + LANES].copy_from_slice(&acc);
-            x += LANES;
-        }
-        for x in x..w {
-            let mut acc = k0 * buf[r + x];
-            for i in 1..=r {
-                acc += k[i] * (buf[r + x - i] + buf[r + x + i]);
-            }
-            out_row[x] = acc;
-        }
+    let stride = w + 2 * r;
+    let n_rows = out.len() / w;
+    let taps = 2 * r + 1;
+    let chunks = w.div_ceil(CHUNK);
+    let cwpr = chunks.div_ceil(64);
+    // The unchecked reads of `vquad` rely on these.
+    assert!(src.len() >= w * h && (y0 + n_rows) <= h, "blur: image smaller than its size");
+    if s.vbuf.len() < GROUP * stride {
+        s.vbuf.resize(GROUP * stride, 0.0);
     }
+    if s.rows.len() < GROUP * taps {
+        s.rows.resize(GROUP * taps, 0);
+    }
+    let full: Vec<u64> = (0..cwpr)
+        .map(|i| {
+            let n = chunks.saturating_sub(i * 64).min(64);
+            if n == 64 { u64::MAX } else { (1u64 << n) - 1 }
+        })
+        .collect();
+    // Union of the chunk masks of a quad's rows (`None`: every chunk).
+    let union = |m: Option<&ChunkMask>, y: [usize; QUAD], u: &mut Vec<u64>| {
+        u.clear();
+        match m {
+            None => u.extend_from_slice(&full),
+            Some(m) => {
+                u.resize(cwpr, 0);
+                for &yy in &y {
+                    for (a, b) in u.iter_mut().zip(m.row(yy)) {
+                        *a |= b;
+                    }
+                }
+            }
+        }
+    };
+    let mut consts = ConstCache::new(kernel);
+    let mut u = std::mem::take(&mut s.spans_u64);
+    let mut gy = 0;
+    while gy < n_rows {
+        let gn = (n_rows - gy).min(GROUP);
+        for j in 0..gn {
+            let y = y0 + gy + j;
+            let t = &mut s.rows[j * taps..(j + 1) * taps];
+            t[0] = y * w;
+            for i in 1..=r {
+                t[2 * i - 1] = reflect101(y as isize - i as isize, h) * w;
+                t[2 * i] = reflect101((y + i) as isize, h) * w;
+            }
+        }
+        let quads = gn.div_ceil(QUAD);
+        // Vertical pass, strip by strip (the source rows of a strip stay in L1), four rows at a time.
+        if w >= CHUNK {
+            // The quads' chunk masks, then strips outermost.
+            u.clear();
+            for q in 0..quads {
+                let qr = quad_rows(q, gn).map(|j| y0 + gy + j);
+                let at = u.len();
+                match sparse {
+                    None => u.extend_from_slice(&full),
+                    Some(m) => {
+                        u.resize(at + cwpr, 0);
+                        for &yy in &qr {
+                            for (a, b) in u[at..].iter_mut().zip(m.vert.row(yy)) {
+                                *a |= b;
+                            }
+                        }
+                    }
+                }
+            }
+            let strip_chunks = STRIP / CHUNK;
+            for cs in (0..chunks).step_by(strip_chunks) {
+                let ce = (cs + strip_chunks).min(chunks);
+                for q in 0..quads {
+                    let qr = quad_rows(q, gn);
+                    let rows = qr.map(|j| &s.rows[j * taps..(j + 1) * taps]);
+                    for (a, b, on) in ChunkRuns::new(&u[q * cwpr..(q + 1) * cwpr], ce) {
+                        if !on || b <= cs {
+                            continue;
+                        }
+                        for c in a.max(cs)..b {
+                            let x = block_x(c, w);
+                            // SAFETY: `rows[j]` has `2 r + 1` offsets, each `row * w` with `row < h`, and
+                            // `x + CHUNK <= w`, so every read ends within `h * w <= src.len()`.
+                            let acc = unsafe { vquad(src, rows, k, x) };
+                            for (j, v) in qr.iter().zip(&acc) {
+                                s.vbuf[j * stride + r + x..j * stride + r + x + CHUNK].copy_from_slice(v);
+                            }
+                        }
+                    }
+                }
+            }
+        } else {
+            for j in 0..gn {
+                let t = &s.rows[j * taps..(j + 1) * taps];
+                for x in 0..w {
+                    s.vbuf[j * stride + r + x] = vpixel(src, t, k, x);
+                }
+            }
+        }
+        for j in 0..gn {
+            let y = y0 + gy + j;
+            let buf = &mut s.vbuf[j * stride..(j + 1) * stride];
+            if let Some(m) = sparse {
+                // Columns the vertical pass skipped see one constant: the source pixel's.
+                let row = &src[y * w..y * w + w];
+                for (a, b, on) in ChunkRuns::new(m.vert.row(y), m.vert.chunks) {
+                    if !on {
+                        let (a, b) = cols(a, b, w);
+                        let v = consts.get(row[a]);
+                        buf[r + a..r + b].fill(v);
+                    }
+                }
+            }
+            // Reflect-101 padding of the vertical result.
+            for q in 1..=r {
+                buf[r - q] = buf[r + reflect101(-(q as isize), w)];
+                buf[r + w - 1 + q] = buf[r + reflect101((w - 1 + q) as isize, w)];
+            }
+        }
+        // Horizontal pass, four rows at a time, then the constant outputs.
+        if w >= CHUNK {
+            for q in 0..quads {
+                let qr = quad_rows(q, gn);
+                union(sparse.map(|m| m.out), qr.map(|j| y0 + gy + j), &mut u);
+                let bufs = qr.map(|j| &s.vbuf[j * stride..(j + 1) * stride]);
+                for (a, b, on) in ChunkRuns::new(&u, chunks) {
+                    if !on {
+                        continue;
+                    }
+                    for c in a..b {
+                        let x = block_x(c, w);
+                        // SAFETY: each buffer holds `w + 2 r` values and `x + CHUNK <= w`.
+                        let acc = unsafe { hquad(bufs, k, x) };
+                        for (j, v) in qr.iter().zip(&acc) {
+                            let o = (gy + j) * w + x;
+                            out[o..o + CHUNK].copy_from_slice(v);
+                        }
+                    }
+                }
+            }
+        } else {
+            for j in 0..gn {
+                let buf = &s.vbuf[j * stride..(j + 1) * stride];
+                for x in 0..w {
+                    out[(gy + j) * w + x] = hpixel(buf, k, x);
+                }
+            }
+        }
+        if let Some(m) = sparse {
+            for j in 0..gn {
+                let y = y0 + gy + j;
+                let buf = &s.vbuf[j * stride..(j + 1) * stride];
+                let out_row = &mut out[(gy + j) * w..(gy + j + 1) * w];
+                for (a, b, on) in ChunkRuns::new(m.out.row(y), m.out.chunks) {
+                    if !on {
+                        let (a, b) = cols(a, b, w);
+                        out_row[a..b].fill(consts.get(buf[r + a]));
+                    }
+                }
+            }
+        }
+        gy += gn;
+    }
+    s.spans_u64 = u;
 }
 
 #[cfg(test)]
@@ -268,19 +588,94 @@ mod tests {
             let src: Vec<f32> = (0..w * h).map(|i| ((i * 7919) % 251) as f32).collect();
             let k = Kernel::gaussian(2.0);
             let mut dst = vec![0.0; w * h];
-            let mut buf = Vec::new();
-            blur(&src, &mut dst, w, h, &k, &mut buf, false);
+            let mut buf = BlurScratch::default();
+            blur(&src, &mut dst, w, h, &k, &mut buf, false, None);
             let expect = naive(&src, w, h, &k);
             for (a, b) in dst.iter().zip(&expect) {
                 assert!((a - b).abs() < 1e-3, "{a} vs {b}");
             }
             let mut par = vec![0.0; w * h];
-            blur(&src, &mut par, w, h, &k, &mut buf, true);
+            blur(&src, &mut par, w, h, &k, &mut buf, true, None);
             assert_eq!(par, dst);
         }
         let src = vec![100.0f32; 64 * 70];
         let mut dst = vec![0.0; 64 * 70];
-        blur(&src, &mut dst, 64, 70, &Kernel::gaussian(3.0), &mut Vec::new(), true);
+        blur(&src, &mut dst, 64, 70, &Kernel::gaussian(3.0), &mut BlurScratch::default(), true, None);
         assert!(dst.iter().all(|v| (v - 100.0).abs() < 1e-3));
+    }
+
+    /// The blur in the order of the implementation, one pixel at a time: vertical `k0 c + sum k_i (a + b)`,
+    /// then the same across the reflect-101 padded row.
+    fn paired(src: &[f32], w: usize, h: usize, k: &Kernel) -> Vec<f32> {
+        let r = k.radius();
+        let mut tmp = vec![0.0; w * h];
+        for y in 0..h {
+            for x in 0..w {
+                let mut acc = k.half[0] * src[y * w + x];
+                for i in 1..=r {
+                    let (a, b) = (reflect101(y as isize - i as isize, h), reflect101((y + i) as isize, h));
+                    acc += k.half[i] * (src[a * w + x] + src[b * w + x]);
+                }
+                tmp[y * w + x] = acc;
+            }
+        }
+        let mut out = vec![0.0; w * h];
+        for y in 0..h {
+            for x in 0..w {
+                let mut acc = k.half[0] * tmp[y * w + x];
+                for i in 1..=r {
+                    let (a, b) = (reflect101(x as isize - i as isize, w), reflect101((x + i) as isize, w));
+                    acc += k.half[i] * (tmp[y * w + a] + tmp[y * w + b]);
+                }
+                out[y * w + x] = acc;
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn blur_is_bitwise_the_paired_formula_dense_and_sparse() {
+        use crate::mask::BitMask;
+        let mut seed = 7u64;
+        let mut rnd = || {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (seed >> 33) as usize
+        };
+        let mut exercised = false;
+        for &(w, h) in &[(200usize, 90usize), (37, 41), (15, 9), (64, 3), (1, 20), (130, 1)] {
+            // Flat areas of three levels with random boxes (some fractional, some negative).
+            let mut src: Vec<f32> = (0..w * h).map(|i| [255.0, 0.3, -7.5][(i % w) * 3 / w]).collect();
+            for _ in 0..(w * h / 300 + 2) {
+                let (x0, y0, v) = (rnd() % w, rnd() % h, (rnd() % 5000) as f32 * 0.37 - 900.0);
+                for y in y0..(y0 + 1 + rnd() % 6).min(h) {
+                    for x in x0..(x0 + 1 + rnd() % 6).min(w) {
+                        src[y * w + x] = v;
+                    }
+                }
+            }
+            for sigma in [0.8, 1.2262735, 3.0900155, 6.0] {
+                let k = Kernel::gaussian(sigma);
+                let want = paired(&src, w, h, &k);
+                let mut s = BlurScratch::default();
+                let mut dense = vec![0.0; w * h];
+                blur(&src, &mut dense, w, h, &k, &mut s, false, None);
+                // Sparse: masks from the source's edges grown by the radius (as the pyramid does).
+                let (mut edges, mut vm, mut am) = (BitMask::default(), BitMask::default(), BitMask::default());
+                edges.edges_of(&src, w, h);
+                vm.dilate_vertical(&edges, k.radius());
+                am.dilate_horizontal(&vm, k.radius());
+                let (mut vert, mut out) = (ChunkMask::default(), ChunkMask::default());
+                vert.build(&vm, 0, w);
+                out.build(&am, 0, w);
+                let mut sparse = vec![f32::NAN; w * h];
+                blur(&src, &mut sparse, w, h, &k, &mut s, false, Some(Sparse { vert: &vert, out: &out }));
+                for i in 0..w * h {
+                    assert_eq!(dense[i].to_bits(), want[i].to_bits(), "dense {w}x{h} sigma {sigma} at {i}");
+                    assert_eq!(sparse[i].to_bits(), want[i].to_bits(), "sparse {w}x{h} sigma {sigma} at {i}");
+                }
+                exercised |= am.density() < 0.8;
+            }
+        }
+        assert!(exercised, "some blur skipped constant parts");
     }
 }

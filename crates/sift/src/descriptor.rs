@@ -147,12 +147,15 @@ fn descriptor_impl(
             let cbin = c_rot + half;
             if rbin > -1.0 && rbin < D as f32 && cbin > -1.0 && cbin < D as f32 {
                 let c = c as usize;
-                sdx[k] = mid[c + 1] - mid[c - 1];
-                sdy[k] = up[c] - down[c];
+                let (gx, gy) = (mid[c + 1] - mid[c - 1], up[c] - down[c]);
+                // A zero gradient adds +0 to every share (the histogram's entries are sums of values
+                // >= +0, never -0): leaving it out changes no bit. Flat map areas are full of them.
+                sdx[k] = gx;
+                sdy[k] = gy;
                 srb[k] = rbin;
                 scb[k] = cbin;
                 sw[k] = wi * ex[j.unsigned_abs()];
-                k += 1;
+                k += usize::from(gx != 0.0 || gy != 0.0);
             }
         }
     }

@@ -1,5 +1,6 @@
 //! Scale-space extrema: 26-neighbour detection, sub-pixel/sub-scale refinement, contrast and edge tests.
 
+use crate::mask::{ChunkMask, ChunkRuns};
 use crate::params::SiftParams;
 
 /// A pixel that is a strict-or-equal extremum among its 26 neighbours in a DoG layer.
@@ -50,8 +51,8 @@ impl DogView<'_> {
     }
 }
 
-/// Columns tested together.
-const CHUNK: usize = 16;
+/// Columns tested together (the scan mask's chunks).
+const CHUNK: usize = crate::mask::CHUNK;
 
 /// Reusable rolling rows (3 per DoG layer): DoG values and their 3-wide horizontal maxima and minima.
 #[derive(Debug, Default, Clone)]
@@ -72,6 +73,11 @@ pub struct DogRows {
 /// Only rows `rows` (clamped to `border .. h - border`) are scanned, so a caller can scan an octave in
 /// consecutive row ranges as its layers become available (Gaussian rows up to `rows.end` must be final);
 /// the ranges must start at `border` and follow each other (the rolling buffer carries over).
+///
+/// With `mask` (chunks of 16 columns from column `border`, one row of chunks per image row), only the
+/// masked chunks are scanned, and DoG rows are formed only where those scans read them; the caller
+/// guarantees that no pixel outside the mask has `|D| > threshold` in any tested layer, so the candidates
+/// (and their order) are those of the full scan.
 #[allow(clippy::too_many_arguments)]
 pub fn find_candidates(
     gauss: &[Vec<f32>],
@@ -81,6 +87,7 @@ pub fn find_candidates(
     threshold: f32,
     border: usize,
     rows: std::ops::Range<usize>,
+    mask: Option<&ChunkMask>,
     ring: &mut DogRows,
     out: &mut Vec<Candidate>,
 ) {
@@ -88,16 +95,16 @@ pub fn find_candidates(
     {
         if std::arch::is_x86_feature_detected!("avx512f") {
             // SAFETY: the CPU supports AVX-512F (checked just above).
-            unsafe { find_candidates_avx512(gauss, w, h, n_layers, threshold, border, rows, ring, out) };
+            unsafe { find_candidates_avx512(gauss, w, h, n_layers, threshold, border, rows, mask, ring, out) };
             return;
         }
         if std::arch::is_x86_feature_detected!("avx2") {
             // SAFETY: the CPU supports AVX2 (checked just above).
-            unsafe { find_candidates_avx2(gauss, w, h, n_layers, threshold, border, rows, ring, out) };
+            unsafe { find_candidates_avx2(gauss, w, h, n_layers, threshold, border, rows, mask, ring, out) };
             return;
         }
     }
-    find_candidates_impl(gauss, w, h, n_layers, threshold, border, rows, ring, out);
+    find_candidates_impl(gauss, w, h, n_layers, threshold, border, rows, mask, ring, out);
 }
 
 #[cfg(target_arch = "x86_64")]
@@ -111,10 +118,11 @@ fn find_candidates_avx512(
     threshold: f32,
     border: usize,
     rows: std::ops::Range<usize>,
+    mask: Option<&ChunkMask>,
     ring: &mut DogRows,
     out: &mut Vec<Candidate>,
 ) {
-    find_candidates_impl(gauss, w, h, n_layers, threshold, border, rows, ring, out);
+    find_candidates_impl(gauss, w, h, n_layers, threshold, border, rows, mask, ring, out);
 }
 
 #[cfg(target_arch = "x86_64")]
@@ -128,10 +136,11 @@ fn find_candidates_avx2(
     threshold: f32,
     border: usize,
     rows: std::ops::Range<usize>,
+    mask: Option<&ChunkMask>,
     ring: &mut DogRows,
     out: &mut Vec<Candidate>,
 ) {
-    find_candidates_impl(gauss, w, h, n_layers, threshold, border, rows, ring, out);
+    find_candidates_impl(gauss, w, h, n_layers, threshold, border, rows, mask, ring, out);
 }
 
 #[inline(always)]
@@ -144,6 +153,7 @@ fn find_candidates_impl(
     threshold: f32,
     border: usize,
     rows: std::ops::Range<usize>,
+    mask: Option<&ChunkMask>,
     ring: &mut DogRows,
     out: &mut Vec<Candidate>,
 ) {
@@ -158,38 +168,76 @@ fn find_candidates_impl(
         }
     }
     let (dog, hmax, hmin) = (&mut ring.dog[..ring_len], &mut ring.hmax[..ring_len], &mut ring.hmin[..ring_len]);
-    #[inline(always)]
-    fn fill_row(gauss: &[Vec<f32>], w: usize, n_dog: usize, rows: (&mut [f32], &mut [f32], &mut [f32]), y: usize) {
-        let (dog, hmax, hmin) = rows;
-        for l in 0..n_dog {
-            let slot = (l * 3 + y % 3) * w;
-            let d = &mut dog[slot..slot + w];
-            let (a, b) = (&gauss[l][y * w..y * w + w], &gauss[l + 1][y * w..y * w + w]);
-            for ((o, &x), &z) in d.iter_mut().zip(a).zip(b) {
-                *o = z - x;
-            }
-            let d: &[f32] = d;
-            let (mx, mn) = (&mut hmax[slot + 1..slot + w - 1], &mut hmin[slot + 1..slot + w - 1]);
-            for ((o, p), q) in mx.iter_mut().zip(mn.iter_mut()).zip(d.windows(3)) {
-                let m = if q[0] > q[1] { q[0] } else { q[1] };
-                *o = if q[2] > m { q[2] } else { m };
-                let m = if q[0] < q[1] { q[0] } else { q[1] };
-                *p = if q[2] < m { q[2] } else { m };
-            }
-        }
-    }
     let (r_from, r_to) = (rows.start.max(border), rows.end.min(h - border));
     if r_from >= r_to {
         return;
     }
+    let end = w - border;
+    // Scan chunks: from column `border`, the last one possibly partial.
+    let chunks = (end - border).div_ceil(CHUNK);
+    let cwpr = chunks.div_ceil(64);
+    let mut union = vec![0u64; cwpr];
+    let full: Vec<u64> = (0..cwpr)
+        .map(|i| {
+            let n = chunks.saturating_sub(i * 64).min(64);
+            if n == 64 { u64::MAX } else { (1u64 << n) - 1 }
+        })
+        .collect();
+    // The chunk bits of scan row y (none outside the scanned rows).
+    let mask_row = |y: usize| -> Option<&[u64]> {
+        if y < border || y >= h - border {
+            return None;
+        }
+        mask.map(|m| m.row(y))
+    };
+    // Forms DoG row y (with its running max / min) where scans of rows y - 1, y, y + 1 read it.
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    fn fill(
+        gauss: &[Vec<f32>],
+        w: usize,
+        n_dog: usize,
+        ring: (&mut [f32], &mut [f32], &mut [f32]),
+        y: usize,
+        masked: bool,
+        near: [Option<&[u64]>; 3],
+        union: &mut [u64],
+        chunks: usize,
+        border: usize,
+        end: usize,
+    ) {
+        let (dog, hmax, hmin) = ring;
+        if !masked {
+            fill_row(gauss, w, n_dog, (dog, hmax, hmin), y, 1, w - 1);
+            return;
+        }
+        union.fill(0);
+        for r in near.into_iter().flatten() {
+            for (a, b) in union.iter_mut().zip(r) {
+                *a |= b;
+            }
+        }
+        for (a, b, on) in ChunkRuns::new(union, chunks) {
+            if on {
+                let (c0, c1) = (border + a * CHUNK, (border + b * CHUNK).min(end));
+                fill_row(gauss, w, n_dog, (&mut *dog, &mut *hmax, &mut *hmin), y, c0, c1);
+            }
+        }
+    }
+    let masked = mask.is_some();
+    let near = |y: usize| [mask_row(y.wrapping_sub(1)), mask_row(y), mask_row(y + 1)];
     if r_from == border {
-        fill_row(gauss, w, n_dog, (&mut *dog, &mut *hmax, &mut *hmin), border - 1);
-        fill_row(gauss, w, n_dog, (&mut *dog, &mut *hmax, &mut *hmin), border);
+        for y in [border - 1, border] {
+            let ring = (&mut *dog, &mut *hmax, &mut *hmin);
+            fill(gauss, w, n_dog, ring, y, masked, near(y), &mut union, chunks, border, end);
+        }
     }
     for r in r_from..r_to {
-        fill_row(gauss, w, n_dog, (&mut *dog, &mut *hmax, &mut *hmin), r + 1);
+        let ring = (&mut *dog, &mut *hmax, &mut *hmin);
+        fill(gauss, w, n_dog, ring, r + 1, masked, near(r + 1), &mut union, chunks, border, end);
         let (dog, hmax, hmin): (&[f32], &[f32], &[f32]) = (dog, hmax, hmin);
         let row = |l: usize, y: usize| (l * 3 + y % 3) * w;
+        let runs = mask_row(r).unwrap_or(&full);
         for layer in 1..=n_layers {
             let cur = &dog[row(layer, r)..row(layer, r) + w];
             let mut maxs: [&[f32]; 9] = [cur; 9];
@@ -203,25 +251,62 @@ fn find_candidates_impl(
                     k += 1;
                 }
             }
-            scan_row(cur, &maxs, &mins, w, border, threshold, |c| out.push(Candidate { r, c, layer }));
+            for (a, b, on) in ChunkRuns::new(runs, chunks) {
+                if on {
+                    let (c0, c1) = (border + a * CHUNK, (border + b * CHUNK).min(end));
+                    scan_row(cur, &maxs, &mins, c0, c1, threshold, |c| out.push(Candidate { r, c, layer }));
+                }
+            }
         }
     }
 }
 
-/// Tests columns `border .. w - border` of one DoG row: `maxs` / `mins` are the 3-wide running max / min
-/// of the 9 rows around it (3 layers x 3 rows).
+/// Forms DoG row `y` of every layer into the rolling buffer at columns `c0 - 1 .. c1 + 1` (clipped to the
+/// image), and its 3-wide running max / min at columns `c0 .. c1` (`1 <= c0`, `c1 <= w - 1`).
+#[inline(always)]
+fn fill_row(
+    gauss: &[Vec<f32>],
+    w: usize,
+    n_dog: usize,
+    rows: (&mut [f32], &mut [f32], &mut [f32]),
+    y: usize,
+    c0: usize,
+    c1: usize,
+) {
+    let (dog, hmax, hmin) = rows;
+    let (d0, d1) = (c0 - 1, c1 + 1);
+    for l in 0..n_dog {
+        let slot = (l * 3 + y % 3) * w;
+        let d = &mut dog[slot + d0..slot + d1];
+        let (a, b) = (&gauss[l][y * w + d0..y * w + d1], &gauss[l + 1][y * w + d0..y * w + d1]);
+        for ((o, &x), &z) in d.iter_mut().zip(a).zip(b) {
+            *o = z - x;
+        }
+        let d: &[f32] = d;
+        let (mx, mn) = (&mut hmax[slot + c0..slot + c1], &mut hmin[slot + c0..slot + c1]);
+        for ((o, p), q) in mx.iter_mut().zip(mn.iter_mut()).zip(d.windows(3)) {
+            let m = if q[0] > q[1] { q[0] } else { q[1] };
+            *o = if q[2] > m { q[2] } else { m };
+            let m = if q[0] < q[1] { q[0] } else { q[1] };
+            *p = if q[2] < m { q[2] } else { m };
+        }
+    }
+}
+
+/// Tests columns `c0 .. c1` of one DoG row: `maxs` / `mins` are the 3-wide running max / min of the 9
+/// rows around it (3 layers x 3 rows). Whole chunks are tested together, the rest one by one.
 #[inline(always)]
 fn scan_row(
     cur: &[f32],
     maxs: &[&[f32]; 9],
     mins: &[&[f32]; 9],
-    w: usize,
-    border: usize,
+    c0: usize,
+    c1: usize,
     thr: f32,
     mut push: impl FnMut(usize),
 ) {
-    let end = w - border;
-    let mut c = border;
+    let end = c1;
+    let mut c = c0;
     while c + CHUNK <= end {
         let v: &[f32; CHUNK] = cur[c..c + CHUNK].try_into().expect("chunk");
         let mut any = false;
@@ -413,10 +498,10 @@ mod tests {
         g[2][20 * w + 31] = -3.0; // equal neighbour: still an extremum (>= test), both found
         let mut out = Vec::new();
         let mut ring = DogRows::default();
-        find_candidates(&g, w, h, 1, 1.0, 5, 0..h, &mut ring, &mut out);
+        find_candidates(&g, w, h, 1, 1.0, 5, 0..h, None, &mut ring, &mut out);
         let mut split = Vec::new();
-        find_candidates(&g, w, h, 1, 1.0, 5, 0..13, &mut ring, &mut split);
-        find_candidates(&g, w, h, 1, 1.0, 5, 13..h, &mut ring, &mut split);
+        find_candidates(&g, w, h, 1, 1.0, 5, 0..13, None, &mut ring, &mut split);
+        find_candidates(&g, w, h, 1, 1.0, 5, 13..h, None, &mut ring, &mut split);
         assert_eq!(out, split);
         out.sort_by_key(|c| (c.r, c.c));
         assert_eq!(
@@ -428,7 +513,7 @@ mod tests {
             ]
         );
         out.clear();
-        find_candidates(&g, 10, 10, 1, 1.0, 5, 0..10, &mut ring, &mut out);
+        find_candidates(&g, 10, 10, 1, 1.0, 5, 0..10, None, &mut ring, &mut out);
         assert!(out.is_empty());
     }
 }

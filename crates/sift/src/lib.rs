@@ -21,9 +21,12 @@ mod extrema;
 mod fastmath;
 mod image;
 mod keypoint;
+mod mask;
 mod orientation;
 mod params;
 mod pyramid;
+#[cfg(test)]
+mod sparse_tests;
 
 pub use error::SiftError;
 pub use image::GrayImage;
@@ -62,9 +65,17 @@ type Found = (Keypoint, [u8; DESCRIPTOR_LEN]);
 impl Sift {
     /// A detector with these parameters.
     pub fn new(params: SiftParams) -> Self {
+        Self::with_sparse(params, true)
+    }
+
+    /// A detector that skips the constant parts of the images (`sparse`) or computes every pixel; the
+    /// output is the same either way, bit for bit (the dense form is kept as the reference for tests).
+    fn with_sparse(params: SiftParams, sparse: bool) -> Self {
+        let mut octave = Octave::default();
+        octave.sparse = sparse;
         Self {
             params,
-            octave: Octave::default(),
+            octave,
             candidates: Vec::new(),
             dog_rows: DogRows::default(),
             ori: OriScratch::default(),
@@ -109,16 +120,17 @@ impl Sift {
                 break;
             }
             let (ow, oh) = (self.octave.w, self.octave.h);
+            self.octave.plan(threshold, p.border);
             self.candidates.clear();
             let (cands, ring) = (&mut self.candidates, &mut self.dog_rows);
             let n_layers = p.n_octave_layers;
-            let scan = |g: &[Vec<f32>], r0: usize, r1: usize| {
-                find_candidates(g, ow, oh, n_layers, threshold, p.border, r0..r1, ring, cands)
+            let scan = |g: &[Vec<f32>], mask: Option<&mask::ChunkMask>, r0: usize, r1: usize| {
+                find_candidates(g, ow, oh, n_layers, threshold, p.border, r0..r1, mask, ring, cands)
             };
             if p.parallel {
                 self.octave.build(true);
                 let mut scan = scan;
-                scan(&self.octave.gauss, 0, oh);
+                scan(&self.octave.gauss, self.octave.scan_mask(), 0, oh);
             } else {
                 self.octave.build_scan(scan);
             }
@@ -153,22 +165,24 @@ impl Sift {
                 kp.size *= 0.5;
             }
         }
-        // OpenCV KeyPointsFilter::removeDuplicatedSorted.
-        found.sort_by(|a, b| keypoint_order(&a.0, &b.0));
-        found.dedup_by(|b, a| a.0.x == b.0.x && a.0.y == b.0.y && a.0.size == b.0.size && a.0.angle == b.0.angle);
+        // OpenCV KeyPointsFilter::removeDuplicatedSorted. Sorted as (keypoint, index) pairs (stable, so
+        // the same order as sorting the descriptors along), descriptors gathered at the end.
+        let mut order: Vec<(Keypoint, usize)> = found.iter().enumerate().map(|(i, f)| (f.0, i)).collect();
+        order.sort_by(|a, b| keypoint_order(&a.0, &b.0));
+        order.dedup_by(|b, a| a.0.x == b.0.x && a.0.y == b.0.y && a.0.size == b.0.size && a.0.angle == b.0.angle);
         if let Some(max) = p.max_features
-            && found.len() > max
+            && order.len() > max
         {
-            found.sort_by(|a, b| b.0.response.total_cmp(&a.0.response));
-            found.truncate(max);
+            order.sort_by(|a, b| b.0.response.total_cmp(&a.0.response));
+            order.truncate(max);
         }
         let mut out = Features {
-            keypoints: Vec::with_capacity(found.len()),
-            descriptors: Vec::with_capacity(found.len() * DESCRIPTOR_LEN),
+            keypoints: Vec::with_capacity(order.len()),
+            descriptors: Vec::with_capacity(order.len() * DESCRIPTOR_LEN),
         };
-        for (kp, d) in found {
+        for (kp, i) in order {
             out.keypoints.push(kp);
-            out.descriptors.extend_from_slice(&d);
+            out.descriptors.extend_from_slice(&found[i].1);
         }
         out
     }

@@ -95,9 +95,14 @@ fn orientation_hist_impl(
         let x1 = (xi + radius).min(w as isize - 2);
         for xx in x0..=x1 {
             let p = row + xx as usize;
-            s.dx.push(img[p + 1] - img[p - 1]);
-            s.dy.push(img[p - w] - img[p + w]);
-            s.w.push(wy * s.ex[(xx - xi).unsigned_abs()]);
+            let (gx, gy) = (img[p + 1] - img[p - 1], img[p - w] - img[p + w]);
+            // A zero gradient adds `wt * 0 = +0` to a bin (bins are sums of values >= +0): skipping it
+            // changes no bit.
+            if gx != 0.0 || gy != 0.0 {
+                s.dx.push(gx);
+                s.dy.push(gy);
+                s.w.push(wy * s.ex[(xx - xi).unsigned_abs()]);
+            }
         }
     }
     let mut temp = [0.0f32; ORI_HIST_BINS + 4];

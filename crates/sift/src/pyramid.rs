@@ -4,7 +4,8 @@
 //! shrunk, so a reused `Sift` does not touch fresh memory). DoG images are not stored: a DoG value is the
 //! difference of two Gaussian layers, formed where it is needed (see `extrema`).
 
-use crate::blur::{Kernel, blur, blur_band};
+use crate::blur::{BlurScratch, Kernel, Sparse, blur, blur_band};
+use crate::mask::{BitMask, ChunkMask, Flat};
 use crate::params::SiftParams;
 
 /// One octave of the scale space: `n_layers + 3` Gaussian images (DoG layer `i` is `gauss[i + 1] - gauss[i]`).
@@ -21,17 +22,150 @@ pub struct Octave {
     kernels: Vec<Kernel>,
     /// Spare image buffer (upscaling, next octave's base).
     spare: Vec<f32>,
-    /// Row scratch of the blur.
-    row_buf: Vec<f32>,
+    /// Scratch of the blur.
+    scratch: BlurScratch,
     /// Scratch of the upscaling (horizontally doubled rows).
     up_rows: Vec<f32>,
+    /// Skip the constant parts of the images (see `mask`); false computes every pixel (same result).
+    pub sparse: bool,
+    /// This octave uses the masks (`sparse` and its base is mostly constant).
+    masked: bool,
+    /// Per layer `i >= 1`: chunks where blurring `gauss[i - 1]` into `gauss[i]` must compute.
+    vert: Vec<ChunkMask>,
+    out: Vec<ChunkMask>,
+    /// Active pixels of the current layer while planning (and of `gauss[0]` after `init_base` / `next_base`).
+    level: BitMask,
+    /// Edge mask of the image this octave's layers are blurred from (the upscaled input for the first
+    /// octave, `gauss[0]` for the others), with what it leaves out.
+    base_edges: BitMask,
+    base_flat: Flat,
+    /// Blur from that image to `gauss[0]` (the initial blur for the first octave, identity for the others).
+    base_kernel: Kernel,
+    /// Scratch of the planning.
+    tmp: BitMask,
+    tmp2: BitMask,
+    /// Chunks (scan grid) where the extremum scan must look; `None` scans everything.
+    scan: Option<ChunkMask>,
+    scan_spare: ChunkMask,
 }
+
+/// Above this fraction of edge pixels in an octave's base, tracking the constant parts costs more than
+/// it saves (textured images): the octave is computed in full.
+const MAX_EDGE_DENSITY: f64 = 0.3;
 
 /// Grows `buf` to at least `n` values (never shrinks it).
 fn ensure_len(buf: &mut Vec<f32>, n: usize) {
     if buf.len() < n {
         buf.resize(n, 0.0);
     }
+}
+
+/// Bound on `|blur(c) / c - 1|` over both passes of `kernel` applied to a constant `c` in f32 arithmetic
+/// (weights >= 0: each pass is `S c (1 + t)` with `S` the weights' exact sum and `|t| <= gamma(r + 1)`).
+fn constant_drift(kernel: &Kernel) -> f64 {
+    let r = kernel.radius() as f64;
+    let sum: f64 = f64::from(kernel.half[0]) + 2.0 * kernel.half[1..].iter().map(|&v| f64::from(v)).sum::<f64>();
+    let u = f64::powi(2.0, -24);
+    let gamma = (r + 1.0) * u / (1.0 - (r + 1.0) * u);
+    let hi = (sum * (1.0 + gamma)).powi(2);
+    let lo = (sum * (1.0 - gamma)).powi(2);
+    (hi - 1.0).max(1.0 - lo) + 1e-12
+}
+
+/// `gamma(n) = n u / (1 - n u)`, the relative error bound of `n` rounded f32 operations.
+fn gamma(n: f64) -> f64 {
+    let u = f64::powi(2.0, -24);
+    n * u / (1.0 - n * u)
+}
+
+/// The smallest `d >= 1` such that every DoG value of layers `1..=n_layers` at a pixel whose Chebyshev
+/// distance to the nearest edge pixel of the base image is `>= d` has magnitude `<= threshold`, as
+/// computed in f32; `None` when no distance guarantees it.
+///
+/// Why: with `K_l` the 2-D kernel taking the base `U` to layer `l` (the composition of the blurs, exact
+/// arithmetic, f32 weights), `D_l = (K_{l+1} - K_l) * U`. Within distance `d - 1` of such a pixel `p`
+/// the base is one constant `c = U(p)` (adjacent non-edge pixels are equal; reflect-101 borders mirror
+/// pixels of that same square), so `D_l(p) = c sum(K_{l+1} - K_l) + sum_{|q|_inf >= d} (K_{l+1} -
+/// K_l)(q) (U(p - q) - c)`, at most `M |S_{l+1} - S_l| + X T(d)` in magnitude, where `M` bounds `|U|`,
+/// `X` (`spread`) bounds `|U(q) - U(p)|`, `S` is a kernel's sum and `T(d)` the mass of `|K_{l+1} - K_l|`
+/// outside the square of radius `d - 1`. The f32 results differ from the exact ones by at most
+/// `err_l + err_{l+1}`.
+pub fn dog_reach(
+    base: &Kernel,
+    kernels: &[Kernel],
+    n_layers: usize,
+    max_abs: f64,
+    spread: f64,
+    threshold: f32,
+) -> Option<usize> {
+    let full = |k: &Kernel| -> Vec<f64> {
+        let r = k.radius();
+        (0..2 * r + 1).map(|i| f64::from(k.half[i.abs_diff(r)])).collect()
+    };
+    let conv = |a: &[f64], b: &[f64]| -> Vec<f64> {
+        let mut out = vec![0.0; a.len() + b.len() - 1];
+        for (i, &x) in a.iter().enumerate() {
+            for (j, &y) in b.iter().enumerate() {
+                out[i + j] += x * y;
+            }
+        }
+        out
+    };
+    // Per layer: the 1-D composite kernel, the f32 error bound and the magnitude bound.
+    let sum = |k: &Kernel| f64::from(k.half[0]) + 2.0 * k.half[1..].iter().map(|&v| f64::from(v)).sum::<f64>();
+    let step = |k: &Kernel, err: f64, m: f64| {
+        let (s, g) = (sum(k), gamma(k.radius() as f64 + 3.0));
+        if k.radius() == 0 && k.half[0] == 1.0 {
+            return (err, m); // identity: no arithmetic
+        }
+        (s * s * (1.0 + g) * (1.0 + g) * err + 2.5 * g * s * s * m, s * s * (1.0 + g) * (1.0 + g) * m)
+    };
+    let mut comp = vec![full(base)];
+    let (mut err, mut m) = step(base, 0.0, max_abs);
+    let mut errs = vec![err];
+    for k in &kernels[1..=n_layers + 1] {
+        let next = conv(comp.last().expect("base layer"), &full(k));
+        comp.push(next);
+        (err, m) = step(k, err, m);
+        errs.push(err);
+    }
+    let _ = m;
+    // T(d) = sum of |K_{l+1} - K_l| over the 2-D offsets q with |q|_inf >= d, from the separable
+    // composites (K(x, y) = k(x) k(y)), bucketed by Chebyshev radius; f64 rounding is covered by a slack.
+    let tails = |a: &[f64], b: &[f64]| -> Vec<f64> {
+        let (ra, rb) = (a.len() / 2, b.len() / 2);
+        let r = ra.max(rb);
+        let at = |k: &[f64], rk: usize, x: usize| if x + rk >= r && x < r + rk + 1 { k[x + rk - r] } else { 0.0 };
+        let mut bucket = vec![0.0f64; r + 2];
+        for y in 0..=2 * r {
+            for x in 0..=2 * r {
+                let d = (at(b, rb, x) * at(b, rb, y) - at(a, ra, x) * at(a, ra, y)).abs();
+                bucket[x.abs_diff(r).max(y.abs_diff(r))] += d;
+            }
+        }
+        // Suffix sums: tail[d] = mass at radius >= d.
+        for d in (0..=r).rev() {
+            bucket[d] += bucket[d + 1];
+        }
+        bucket
+    };
+    let max_r = comp.iter().map(|k| k.len() / 2).max().unwrap_or(0);
+    let thr = f64::from(threshold);
+    let mut reach = 1;
+    for l in 1..=n_layers {
+        let (a, b) = (&comp[l], &comp[l + 1]);
+        let (sa, sb): (f64, f64) = (a.iter().sum(), b.iter().sum());
+        let fixed = max_abs * (sb * sb - sa * sa).abs() + errs[l] + errs[l + 1];
+        let tail = tails(a, b);
+        let ok = |d: usize| {
+            let t = tail.get(d).copied().unwrap_or(0.0) + 1e-10;
+            let bound = fixed + spread * t;
+            bound * (1.0 + 1e-9) + 1e-30 < thr
+        };
+        let d = (1..=max_r + 1).find(|&d| ok(d))?;
+        reach = reach.max(d);
+    }
+    Some(reach)
 }
 
 impl Octave {
@@ -48,6 +182,8 @@ impl Octave {
         }
         self.kernels = kernels;
         self.gauss.resize_with(n + 3, Vec::new);
+        self.vert.resize_with(n + 3, ChunkMask::default);
+        self.out.resize_with(n + 3, ChunkMask::default);
     }
 
     /// Builds the first octave's base image `gauss[0]` from the input (doubling it if asked) and blurs it
@@ -64,9 +200,32 @@ impl Octave {
         };
         self.w = bw;
         self.h = bh;
+        let kernel = Kernel::gaussian(f64::from(sig_diff));
         let base = &mut self.gauss[0];
         ensure_len(base, bw * bh);
-        blur(&self.spare, base, bw, bh, &Kernel::gaussian(f64::from(sig_diff)), &mut self.row_buf, params.parallel);
+        self.masked = false;
+        if self.sparse {
+            // Upscaled pixels only repeat constants where the input does: derive their edge mask from the
+            // input's (4x fewer pixels to look at) while f32 holds the interpolation fractions exactly.
+            self.base_flat = if params.upscale && bw.max(bh) <= 1 << 22 {
+                let flat = self.tmp.edges_of(data, w, h);
+                self.base_edges.upscaled_edges(&self.tmp, !border_interpolates_exactly(data, w, h));
+                Flat { max_abs: flat.max_abs * (1.0 + 1e-6), ..flat }
+            } else {
+                self.base_edges.edges_of(&self.spare[..bw * bh], bw, bh)
+            };
+            self.masked = self.base_flat.density <= MAX_EDGE_DENSITY;
+        }
+        if self.masked {
+            self.level.copy_from(&self.base_edges);
+            let (mut vert, mut out) = (ChunkMask::default(), ChunkMask::default());
+            grow(&mut self.tmp, &mut self.level, kernel.radius(), &mut vert, &mut out);
+            let sp = Sparse { vert: &vert, out: &out };
+            blur(&self.spare, base, bw, bh, &kernel, &mut self.scratch, params.parallel, Some(sp));
+        } else {
+            blur(&self.spare, base, bw, bh, &kernel, &mut self.scratch, params.parallel, None);
+        }
+        self.base_kernel = kernel;
     }
 
     /// Makes the next octave's base: `gauss[n_layers]` of this octave, every second pixel (OpenCV
@@ -80,7 +239,72 @@ impl Octave {
         std::mem::swap(&mut self.spare, &mut self.gauss[0]);
         self.w = w;
         self.h = h;
+        self.masked = false;
+        if self.sparse {
+            self.base_flat = self.base_edges.edges_of(&self.gauss[0][..w * h], w, h);
+            self.masked = self.base_flat.density <= MAX_EDGE_DENSITY;
+            self.level.copy_from(&self.base_edges);
+        }
+        self.base_kernel = Kernel { half: vec![1.0] };
         true
+    }
+
+    /// Plans the octave (after `init_base` or `next_base`): which chunks each layer's blur must compute
+    /// and which chunks the extremum scan must look at (scan grid from column `border`): only where a DoG
+    /// value of a tested layer may exceed `threshold` (see [`dog_reach`]).
+    pub fn plan(&mut self, threshold: f32, border: usize) {
+        if let Some(m) = self.scan.take() {
+            self.scan_spare = m;
+        }
+        if !self.masked {
+            return;
+        }
+        let n_layers = self.gauss.len() - 3;
+        // Constant pixels drift by a few ulps per blur: |D| <= drift_{l+1} * max|G_l| there.
+        let mut flat = f64::from(self.base_flat.max_abs) * (1.0 + constant_drift(&self.base_kernel));
+        let mut worst = 0.0f64;
+        let mut constant_ok = false;
+        for i in 1..self.gauss.len() {
+            let drift = constant_drift(&self.kernels[i]);
+            grow(&mut self.tmp, &mut self.level, self.kernels[i].radius(), &mut self.vert[i], &mut self.out[i]);
+            if (2..=n_layers + 1).contains(&i) {
+                worst = worst.max(drift * flat);
+            }
+            flat *= 1.0 + drift;
+            if i == n_layers + 1 {
+                constant_ok = worst * (1.0 + 1e-6) + 1e-30 < f64::from(threshold);
+                if constant_ok {
+                    // Pixels outside this mask are constant in every DoG layer the scan tests.
+                    self.tmp2.copy_from(&self.level);
+                }
+            }
+        }
+        let reach = if self.base_flat.all_flat_ok {
+            let m = f64::from(self.base_flat.max_abs);
+            let spread = if self.base_flat.non_negative { m } else { 2.0 * m };
+            dog_reach(&self.base_kernel, &self.kernels, n_layers, m, spread, threshold)
+        } else {
+            None
+        };
+        if let Some(d) = reach {
+            // Pixels farther than `d - 1` from every edge of the base cannot pass the threshold.
+            self.level.dilate_square(&self.base_edges, d - 1, &mut self.tmp);
+            if constant_ok {
+                self.level.and_with(&self.tmp2);
+            }
+        } else if constant_ok {
+            std::mem::swap(&mut self.level, &mut self.tmp2);
+        } else {
+            return;
+        }
+        let mut m = std::mem::take(&mut self.scan_spare);
+        m.build(&self.level, border, self.w.saturating_sub(border));
+        self.scan = Some(m);
+    }
+
+    /// The scan mask of the planned octave (`None`: scan everything).
+    pub fn scan_mask(&self) -> Option<&ChunkMask> {
+        self.scan.as_ref()
     }
 
     /// Blurs `gauss[0]` into the remaining layers.
@@ -90,15 +314,16 @@ impl Octave {
             let (done, rest) = self.gauss.split_at_mut(i);
             let dst = &mut rest[0];
             ensure_len(dst, n);
-            blur(&done[i - 1], dst, self.w, self.h, &self.kernels[i], &mut self.row_buf, parallel);
+            let sp = self.masked.then(|| Sparse { vert: &self.vert[i], out: &self.out[i] });
+            blur(&done[i - 1], dst, self.w, self.h, &self.kernels[i], &mut self.scratch, parallel, sp);
         }
     }
 
     /// Blurs `gauss[0]` into the remaining layers as a wavefront of row bands, so each layer's rows are
-    /// read back (by the next layer's blur and by `scan`) while still in cache. `scan(gauss, r0, r1)` is
-    /// called with consecutive row ranges `0..r1` whose Gaussian rows up to `r1` (inclusive) are final in
-    /// every layer. Same result as [`Octave::build`] followed by one scan of all rows.
-    pub fn build_scan(&mut self, mut scan: impl FnMut(&[Vec<f32>], usize, usize)) {
+    /// read back (by the next layer's blur and by `scan`) while still in cache. `scan(gauss, mask, r0, r1)`
+    /// is called with consecutive row ranges `0..r1` whose Gaussian rows up to `r1` (inclusive) are final
+    /// in every layer. Same result as [`Octave::build`] followed by one scan of all rows.
+    pub fn build_scan(&mut self, mut scan: impl FnMut(&[Vec<f32>], Option<&ChunkMask>, usize, usize)) {
         const BAND: usize = 16;
         let (w, h) = (self.w, self.h);
         let n = w * h;
@@ -116,7 +341,9 @@ impl Octave {
                 let target = ready.min(avail[i] + BAND);
                 if target > avail[i] {
                     let (done, rest) = self.gauss.split_at_mut(i);
-                    blur_band(&done[i - 1], &mut rest[0], w, h, avail[i], target, &self.kernels[i], &mut self.row_buf);
+                    let sp = self.masked.then(|| Sparse { vert: &self.vert[i], out: &self.out[i] });
+                    let k = &self.kernels[i];
+                    blur_band(&done[i - 1], &mut rest[0], w, h, avail[i], target, k, &mut self.scratch, sp);
                     avail[i] = target;
                 }
             }
@@ -124,7 +351,7 @@ impl Octave {
             // Rows whose neighbours (one row below) are final in every layer.
             let upto = if all >= h { h } else { all.saturating_sub(1) };
             if upto > scanned {
-                scan(&self.gauss, scanned, upto);
+                scan(&self.gauss, self.scan.as_ref(), scanned, upto);
                 scanned = upto;
             }
             if all >= h {
@@ -137,6 +364,25 @@ impl Octave {
     pub fn layer(&self, i: usize) -> &[f32] {
         &self.gauss[i][..self.w * self.h]
     }
+}
+
+/// True when every border pixel `c` of the image satisfies `0.75 c + 0.25 c == c` in f32 (as the
+/// upscaling computes it), so the copied outer rows and columns of the upscaled image equal their
+/// interpolated neighbours where the image is constant.
+fn border_interpolates_exactly(data: &[f32], w: usize, h: usize) -> bool {
+    let ok = |c: f32| (c * 0.75 + c * 0.25).to_bits() == c.to_bits();
+    let rows = data[..w].iter().chain(&data[(h - 1) * w..h * w]);
+    let cols = (0..h).flat_map(|y| [data[y * w], data[y * w + w - 1]]);
+    rows.copied().chain(cols).all(ok)
+}
+
+/// One blur step of the activity masks: `level` (active pixels of the input) becomes the active pixels
+/// of the output of a kernel of radius `r`; `vert` / `out` receive the chunks the blur must compute.
+fn grow(tmp: &mut BitMask, level: &mut BitMask, r: usize, vert: &mut ChunkMask, out: &mut ChunkMask) {
+    tmp.dilate_vertical(level, r);
+    vert.build(tmp, 0, tmp.w);
+    level.dilate_horizontal(tmp, r);
+    out.build(level, 0, level.w);
 }
 
 /// OpenCV `resize(.., 2x size, INTER_LINEAR)`: half-pixel-centre bilinear doubling, horizontal pass first.
@@ -243,6 +489,7 @@ mod tests {
         let mut o = Octave::default();
         o.prepare(&p);
         o.init_base(&vec![10.0; 64], 8, 8, &p);
+        o.plan(1.0, 5);
         o.build(false);
         assert_eq!((o.w, o.h, o.gauss.len()), (16, 16, 6));
         assert!((0..6).all(|i| o.layer(i).iter().all(|v| (v - 10.0).abs() < 1e-3)));
