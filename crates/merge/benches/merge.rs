@@ -4,6 +4,7 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use mrslam_merge::floorplan::{FloorplanParams, generate};
 use mrslam_merge::pairs::{PairSpec, cut_pair};
 use mrslam_merge::{MergeParams, SiftMerger, merge};
+use std::collections::BTreeMap;
 use std::hint::black_box;
 
 fn bench_merge(c: &mut Criterion) {
@@ -16,7 +17,21 @@ fn bench_merge(c: &mut Criterion) {
     let params = MergeParams::default();
     let out = merge(&merger, &pair.a, &pair.b, &params);
     assert!(out.report.accepted, "the benchmark pair must merge: {:?}", out.report.reason);
-    eprintln!("stage breakdown of one run (ms): {:?}", out.report.timings_ms);
+    // Stage breakdown: median over 11 runs of each stage (more stable than one run on a shared machine).
+    let mut stages: BTreeMap<String, Vec<f64>> = BTreeMap::new();
+    for _ in 0..11 {
+        let out = merge(&merger, &pair.a, &pair.b, &params);
+        for (k, v) in out.report.timings_ms {
+            stages.entry(k).or_default().push(v);
+        }
+        stages.entry("(whole merge)".into()).or_default().push(out.report.time_ms);
+    }
+    let median = |v: &mut Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        v[v.len() / 2]
+    };
+    let summary: Vec<String> = stages.iter_mut().map(|(k, v)| format!("{k} {:.2}", median(v))).collect();
+    eprintln!("stage medians over 11 runs (ms): {}", summary.join(", "));
     c.bench_function("merge_sift_600x600", |bch| {
         bch.iter(|| merge(&merger, black_box(&pair.a), black_box(&pair.b), &params))
     });

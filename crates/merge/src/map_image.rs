@@ -1,5 +1,6 @@
 //! Map → image: how occupied, free and unknown cells become grey levels for SIFT (paper Alg. 3, lines 2-3).
 
+use mrslam_core::grid::{FREE_LOGODDS, OCCUPIED_LOGODDS};
 use mrslam_core::{CellState, OccupancyGrid};
 use nalgebra::Point2;
 
@@ -85,8 +86,10 @@ impl MapImage {
         for v in 0..h {
             let iy = y0 + h - 1 - v;
             let row = &cells[iy * grid.width() + x0..iy * grid.width() + x0 + w];
+            // `CellState::from_log_odds` as selects, so the loop vectorises.
             for (p, &l) in pixels[v * w..(v + 1) * w].iter_mut().zip(row) {
-                *p = enc.level(CellState::from_log_odds(l));
+                let known = if l < FREE_LOGODDS { enc.free } else { enc.unknown };
+                *p = if l > OCCUPIED_LOGODDS { enc.occupied } else { known };
             }
         }
         if dilation > 0 {
@@ -113,19 +116,32 @@ impl MapImage {
 
 /// Grows the pixels at grey level `level` by `r` pixels (separable square dilation).
 fn dilate_level(pixels: &mut [f32], w: usize, h: usize, level: f32, r: usize) {
-    let mask: Vec<bool> = pixels.iter().map(|&p| p == level).collect();
-    let mut rows = vec![false; w * h];
+    let mask: Vec<u8> = pixels.iter().map(|&p| u8::from(p == level)).collect();
+    // Across: OR of the row shifted by -r ..= r (whole-row operations, vectorised).
+    let mut across = mask.clone();
     for y in 0..h {
-        for x in 0..w {
-            let (a, b) = (x.saturating_sub(r), (x + r).min(w - 1));
-            rows[y * w + x] = mask[y * w + a..=y * w + b].iter().any(|&m| m);
+        let (m, a) = (&mask[y * w..(y + 1) * w], &mut across[y * w..(y + 1) * w]);
+        for s in 1..=r.min(w.saturating_sub(1)) {
+            for (o, &v) in a[s..].iter_mut().zip(&m[..w - s]) {
+                *o |= v;
+            }
+            for (o, &v) in a[..w - s].iter_mut().zip(&m[s..]) {
+                *o |= v;
+            }
         }
     }
+    // Down: OR of the rows y - r ..= y + r.
+    let mut grown = vec![0u8; w];
     for y in 0..h {
-        let (a, b) = (y.saturating_sub(r), (y + r).min(h - 1));
-        for x in 0..w {
-            if (a..=b).any(|yy| rows[yy * w + x]) {
-                pixels[y * w + x] = level;
+        grown.fill(0);
+        for yy in y.saturating_sub(r)..=(y + r).min(h - 1) {
+            for (o, &v) in grown.iter_mut().zip(&across[yy * w..(yy + 1) * w]) {
+                *o |= v;
+            }
+        }
+        for (p, &g) in pixels[y * w..(y + 1) * w].iter_mut().zip(&grown) {
+            if g != 0 {
+                *p = level;
             }
         }
     }

@@ -165,6 +165,55 @@ fn check(
     Checked { hypothesis: h, agreement: agr, ambiguity: ambiguous, reason }
 }
 
+/// Why an accepted hypothesis is not trusted after all: a distinct later hypothesis that fits the maps as well.
+///
+/// A rival need only pass the map checks (common cells, wall agreement, acceptance), not the feature-support
+/// ones: a self-similar map can be explained by two transforms with quite different inlier counts.
+fn rival_reason(
+    a: &OccupancyGrid,
+    b: &OccupancyGrid,
+    walls_b: &[Point2<f64>],
+    chosen: &Checked,
+    rest: impl Iterator<Item = Hypothesis>,
+    p: &MergeParams,
+) -> Option<String> {
+    let map_checks = VerifyParams { min_inliers: 0, min_confidence: 0.0, ..p.verify };
+    let own = chosen.agreement.wall_agreement();
+    for mut h in rest {
+        if p.refine.enabled {
+            h.transform = refine(a, walls_b, &h.transform, &p.refine);
+        }
+        let apart = max_displacement(walls_b, &chosen.hypothesis.transform, &h.transform);
+        if apart <= p.verify.ambiguity_shift_m {
+            continue;
+        }
+        let agr = agreement(a, b, &h.transform);
+        if rejection_reason(&map_checks, 0, 0, &agr).is_none() && agr.wall_agreement() >= p.verify.max_rival_ratio * own
+        {
+            let (d_rot, d_xy) = pose_difference(&chosen.hypothesis.transform, &h.transform);
+            return Some(format!(
+                "two transforms fit: another one, {d_rot:.0} deg and {d_xy:.1} m away, meets {:.0}% of b's walls \
+                 against {:.0}% (rival limit {:.0}%)",
+                100.0 * agr.wall_agreement(),
+                100.0 * own,
+                100.0 * p.verify.max_rival_ratio
+            ));
+        }
+    }
+    None
+}
+
+/// Largest distance between where two transforms put b's wall points, metres.
+fn max_displacement(walls_b: &[Point2<f64>], t1: &Pose2, t2: &Pose2) -> f64 {
+    walls_b.iter().map(|q| (t1 * q - t2 * q).norm()).fold(0.0, f64::max)
+}
+
+/// Rotation (degrees) and translation (metres) between two transforms.
+fn pose_difference(t1: &Pose2, t2: &Pose2) -> (f64, f64) {
+    let d = t1.inverse() * t2;
+    (d.rotation.angle().to_degrees().abs(), d.translation.vector.norm())
+}
+
 /// Runs an algorithm, verifies its answer against both maps, and fuses them when it passes.
 pub fn merge(merger: &dyn Merger, a: &OccupancyGrid, b: &OccupancyGrid, p: &MergeParams) -> MergeOutcome {
     let start = Instant::now();
@@ -199,15 +248,20 @@ pub fn merge(merger: &dyn Merger, a: &OccupancyGrid, b: &OccupancyGrid, p: &Merg
         inliers: alignment.inliers,
         inlier_pairs: alignment.evidence.inlier_pairs.clone(),
     };
-    // The algorithm's answer first, then its alternatives: the first that passes the gate is taken.
-    let mut chosen = check(a, b, &walls_b, primary, alignment.matched_features, p, &mut timings);
-    if chosen.reason.is_some() && p.verify_enabled {
-        for h in &alignment.alternatives {
-            let c = check(a, b, &walls_b, h.clone(), alignment.matched_features, p, &mut timings);
-            if c.reason.is_none() {
-                chosen = c;
-                break;
-            }
+    // The algorithm's answer first, then its alternatives: the first that passes the gate is taken, unless a
+    // distinct later one fits the maps about as well (then neither is trusted).
+    let mut hypotheses = std::iter::once(primary).chain(alignment.alternatives.iter().cloned());
+    let first = hypotheses.next().expect("the primary hypothesis");
+    let mut chosen = check(a, b, &walls_b, first, alignment.matched_features, p, &mut timings);
+    if p.verify_enabled {
+        while chosen.reason.is_some() {
+            let Some(h) = hypotheses.next() else { break };
+            chosen = check(a, b, &walls_b, h, alignment.matched_features, p, &mut timings);
+        }
+        if chosen.reason.is_none() {
+            let t = Instant::now();
+            chosen.reason = rival_reason(a, b, &walls_b, &chosen, hypotheses, p);
+            *timings.entry("rivals".into()).or_insert(0.0) += ms(t);
         }
     }
     let Checked { hypothesis, agreement: agr, ambiguity: ambiguous, reason } = chosen;
@@ -240,4 +294,79 @@ pub fn merge(merger: &dyn Merger, a: &OccupancyGrid, b: &OccupancyGrid, p: &Merg
         timings_ms: timings,
     };
     MergeOutcome { report, merged, evidence: alignment.evidence }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use mrslam_core::pose;
+
+    /// An algorithm that answers with fixed hypotheses.
+    struct Fixed(Vec<Pose2>);
+
+    impl Merger for Fixed {
+        fn name(&self) -> &'static str {
+            "fixed"
+        }
+        fn align(&self, _: &OccupancyGrid, _: &OccupancyGrid) -> Result<Alignment, Box<NoAlignment>> {
+            let hyp = |t: &Pose2| Hypothesis { transform: *t, scale: 1.0, inliers: 12, inlier_pairs: Vec::new() };
+            Ok(Alignment {
+                transform: self.0[0],
+                scale: 1.0,
+                matches: 12,
+                matched_features: 12,
+                inliers: 12,
+                timings_ms: BTreeMap::new(),
+                evidence: Evidence::default(),
+                alternatives: self.0[1..].iter().map(hyp).collect(),
+            })
+        }
+    }
+
+    /// A closed 4 m x 3 m room; with `stub`, a 3 m wall juts in from one side and breaks its symmetry.
+    fn room(stub: bool) -> OccupancyGrid {
+        let (w, h) = (80, 60);
+        let mut g = OccupancyGrid::new(w, h, 0.05, pose(0.0, 0.0, 0.0)).unwrap();
+        for iy in 0..h {
+            for ix in 0..w {
+                let border = ix < 2 || iy < 2 || ix >= w - 2 || iy >= h - 2;
+                let jut = stub && (2..60).contains(&ix) && (18..20).contains(&iy);
+                g.set(ix, iy, if border || jut { 2.0 } else { -2.0 });
+            }
+        }
+        g
+    }
+
+    /// Half a turn about the room's centre: maps the symmetric room onto itself.
+    fn half_turn() -> Pose2 {
+        pose(4.0, 3.0, std::f64::consts::PI)
+    }
+
+    #[test]
+    fn a_symmetric_map_with_two_fitting_transforms_is_refused() {
+        let g = room(false);
+        let out = merge(&Fixed(vec![Pose2::identity(), half_turn()]), &g, &g, &MergeParams::default());
+        assert!(!out.report.accepted);
+        let reason = out.report.reason.unwrap();
+        assert!(reason.starts_with("two transforms fit"), "{reason}");
+        assert!(out.merged.is_none());
+    }
+
+    #[test]
+    fn a_rival_that_contradicts_the_maps_does_not_block_the_merge() {
+        let g = room(true);
+        let out = merge(&Fixed(vec![Pose2::identity(), half_turn()]), &g, &g, &MergeParams::default());
+        assert!(out.report.accepted, "{:?}", out.report.reason);
+        let t = out.report.transform.unwrap();
+        assert!(t.x.abs() < 0.05 && t.y.abs() < 0.05 && t.theta.abs() < 0.01, "{t:?}");
+    }
+
+    #[test]
+    fn the_rival_check_can_be_turned_off() {
+        let g = room(false);
+        let mut p = MergeParams::default();
+        p.verify.max_rival_ratio = f64::INFINITY;
+        let out = merge(&Fixed(vec![Pose2::identity(), half_turn()]), &g, &g, &p);
+        assert!(out.report.accepted, "{:?}", out.report.reason);
+    }
 }

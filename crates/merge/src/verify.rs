@@ -27,6 +27,15 @@ pub struct VerifyParams {
     pub max_ambiguity: f64,
     /// Slide used by the ambiguity check, metres.
     pub ambiguity_shift_m: f64,
+    /// Reject when another hypothesis, distinct from the accepted one, also passes the gate with at least this
+    /// share of its wall agreement: two different transforms fit, as when a symmetric map's halves can be laid
+    /// end to end. Only algorithms returning alternatives are affected; above 1 turns the check off.
+    #[serde(default = "default_max_rival_ratio")]
+    pub max_rival_ratio: f64,
+}
+
+fn default_max_rival_ratio() -> f64 {
+    0.9
 }
 
 impl Default for VerifyParams {
@@ -40,6 +49,7 @@ impl Default for VerifyParams {
             min_wall_agreement: 0.6,
             max_ambiguity: 0.85,
             ambiguity_shift_m: 1.0,
+            max_rival_ratio: default_max_rival_ratio(),
         }
     }
 }
