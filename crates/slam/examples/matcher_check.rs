@@ -12,14 +12,8 @@ fn main() {
     let path = synthetic::waypoint_path(&synthetic::office_loop(), 0.05, 0.1);
     let run = synthetic::simulate(&map, &path, 0.1, &Lidar::hokuyo(), pose(0.0, 0.0, 0.0), &Drift::none(), 1);
     let m = ScanMatcher {
-        laser: Xyt { x: 0.0, y: 0.0, t: 0.0 },
         sigma: env("SIGMA", 0.05),
-        lsigma: 0.075,
-        kernel_size: 1,
-        lstep: 0.05,
-        astep: 0.05,
-        iterations: 5,
-        unknown_score: None,
+        ..ScanMatcher::from_params(&mrslam_slam::SlamParams::default(), Xyt { x: 0.0, y: 0.0, t: 0.0 })
     };
     // map from the first 150 true scans
     let mut tm = TileMap::new(0.05);

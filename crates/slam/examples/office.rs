@@ -65,11 +65,19 @@ fn main() {
         _ => {
             let path = synthetic::waypoint_path(&synthetic::office_loop(), 0.05, 0.1);
             let m = synthetic::office_map();
-            (
-                synthetic::simulate(&m, &path, 0.1, &Lidar::hokuyo(), pose(0.1, 0.0, 0.0), &drift, 11),
-                SlamParams::hokuyo(),
-                5,
-            )
+            let env = |k: &str| std::env::var(k).ok().and_then(|v| v.parse::<f64>().ok());
+            let mut lidar = Lidar::hokuyo();
+            if let Some(r) = env("LIDAR_RANGE") {
+                lidar.range_max = r as f32;
+            }
+            if let Some(f) = env("LIDAR_FOV") {
+                lidar.fov = f.to_radians();
+                lidar.beams = (f / 0.36).round() as usize;
+            }
+            if let Some(s) = env("LIDAR_NOISE") {
+                lidar.sigma = s;
+            }
+            (synthetic::simulate(&m, &path, 0.1, &lidar, pose(0.1, 0.0, 0.0), &drift, 11), SlamParams::hokuyo(), 5)
         }
     };
     let mut seed = seed;
@@ -95,7 +103,12 @@ fn main() {
     let (rms, max) = errors(&f.trajectory(), &run.truth);
     if std::env::var("TRACE").is_ok() {
         let t0 = run.truth[0].1;
-        for (i, (stamp, p)) in f.trajectory().iter().enumerate().step_by(5) {
+        for (i, (stamp, p)) in f
+            .trajectory()
+            .iter()
+            .enumerate()
+            .step_by(std::env::var("TRACE").ok().and_then(|v| v.parse().ok()).unwrap_or(5))
+        {
             let k = run.truth.binary_search_by(|(s, _)| s.total_cmp(stamp)).unwrap();
             let t = relative(&t0, &run.truth[k].1);
             let e = t.inverse() * p;
@@ -103,6 +116,14 @@ fn main() {
             let (tx, ty, _) = mrslam_core::pose::pose_xyt(&run.truth[k].1);
             println!("{i:4} truth ({tx:5.1},{ty:5.1}) err ({ex:+.3},{ey:+.3},{et:+.4})");
         }
+    }
+    if std::env::var("ALL").is_ok() {
+        let ll = f.lineage_log_likelihoods();
+        let mut v: Vec<(f64, f64)> =
+            (0..ll.len()).map(|i| (errors(&f.particle_trajectory(i), &run.truth).0, ll[i])).collect();
+        v.sort_by(|a, b| b.1.total_cmp(&a.1));
+        let s: Vec<String> = v.iter().map(|(r, l)| format!("{r:.3}@{l:.0}")).collect();
+        println!("particles (rms@loglik, best first): {}", s.join(" "));
     }
     let ai = acceptance(&f.map().unwrap(), &run.truth_map, &run.truth[0].1);
     println!(

@@ -2,9 +2,10 @@
 //!
 //! Grisetti, Stachniss and Burgard (2007), "Improved techniques for grid mapping with Rao-Blackwellized
 //! particle filters", as OpenSLAM's GMapping implements it: each particle carries a pose, a log weight, its
-//! own grid map and its trajectory; the proposal is the odometry motion model refined by a hill-climbing scan
-//! matcher on the particle's own map; weights are the scan likelihood at the matched pose; particles are
-//! resampled (systematic) when the effective sample size drops below a threshold.
+//! own grid map and its trajectory; the proposal is the odometry motion model refined by a scan matcher on
+//! the particle's own map (GMapping's hill climber by default; the presets use a likelihood-field matcher,
+//! [`field`]); weights are the scan likelihood at the matched pose; particles are resampled (systematic)
+//! when the effective sample size drops below a threshold.
 //!
 //! Data flow per [`Rbpf::process`] call: odometry increment → [`motion`] sampling for every particle →
 //! (when the robot moved enough) [`scan_matcher`] refinement and likelihood → [`resample`] → the scan's hits
@@ -14,6 +15,7 @@
 //! Units are SI; poses are `nalgebra::Isometry2<f64>`; the map frame is the first processed robot pose.
 
 pub mod error;
+pub mod field;
 pub mod map_build;
 pub mod motion;
 pub mod params;

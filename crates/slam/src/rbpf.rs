@@ -6,7 +6,7 @@ use crate::motion::MotionModel;
 use crate::params::SlamParams;
 use crate::particle::{Particle, TrajectoryNode, ancestry};
 use crate::resample::{normalize, systematic};
-use crate::scan_matcher::{PreparedScan, ScanMatcher, Xyt};
+use crate::scan_matcher::{MatchResult, MotionPrior, PreparedScan, ScanMatcher, Scratch, Xyt};
 use mrslam_core::pose::{pose_xyt, relative};
 use mrslam_core::{LaserScan, OccupancyGrid, Odometry, Pose2, pose};
 use rand::{Rng, SeedableRng};
@@ -16,6 +16,9 @@ use std::sync::Arc;
 
 /// Odometry farther than this from its frame's origin (metres) is refused as corrupt.
 const MAX_ODOM_COORD: f64 = 1e6;
+/// Smallest standard deviations (x, y metres; heading radians) of the `motion_prior`: a robot that barely
+/// moved still gets a prior the scan can overrule.
+const MIN_PRIOR_SIGMA: [f64; 3] = [0.005, 0.005, 0.005];
 /// Most beams accepted in one scan.
 const MAX_BEAMS: usize = 100_000;
 
@@ -142,6 +145,8 @@ pub struct Rbpf {
     last_update_stamp: f64,
     linear_distance: f64,
     angular_distance: f64,
+    /// Variances (robot frame x, y, heading) the motion model added since the last processed scan.
+    motion_var: [f64; 3],
     counters: Counters,
 }
 
@@ -162,16 +167,7 @@ impl Rbpf {
         if !(laser.x.is_finite() && laser.y.is_finite() && laser.t.is_finite()) {
             return Err(SlamError::BadLaserOffset);
         }
-        let matcher = ScanMatcher {
-            laser,
-            sigma: params.sigma,
-            lsigma: params.lsigma,
-            kernel_size: params.kernel_size,
-            lstep: params.lstep,
-            astep: params.astep,
-            iterations: params.iterations,
-            unknown_score: (params.seen_band > 0.0).then_some(params.unknown_score),
-        };
+        let matcher = ScanMatcher::from_params(&params, laser);
         let motion = MotionModel { srr: params.srr, srt: params.srt, str: params.str, stt: params.stt };
         let n = params.particles;
         Ok(Rbpf {
@@ -190,6 +186,7 @@ impl Rbpf {
             last_update_stamp: f64::NEG_INFINITY,
             linear_distance: 0.0,
             angular_distance: 0.0,
+            motion_var: [0.0; 3],
             counters: Counters::default(),
         })
     }
@@ -231,6 +228,13 @@ impl Rbpf {
         }
         self.linear_distance += dx.hypot(dy);
         self.angular_distance += dt.abs();
+        let m = &self.motion;
+        let sx = m.srr * dx.abs() + m.str * dt.abs() + 0.3 * m.srr * dy.abs();
+        let sy = m.srr * dy.abs() + m.str * dt.abs() + 0.3 * m.srr * dx.abs();
+        let st = m.stt * dt.abs() + m.srt * dx.hypot(dy);
+        self.motion_var[0] += sx * sx;
+        self.motion_var[1] += sy * sy;
+        self.motion_var[2] += st * st;
         self.odo_pose = Some(odom.pose);
 
         if scan.is_empty() {
@@ -300,35 +304,32 @@ impl Rbpf {
         let mut resampled = false;
         let mut neff = n as f64;
         if !first {
-            let min_score = p.minimum_score;
-            let guard = p.frontier_guard;
             let matcher = &self.matcher;
-            let beams = &prepared.matched;
+            let prepared = &prepared;
+            let v = self.motion_var;
+            let prior = MotionPrior {
+                sx: v[0].sqrt().max(MIN_PRIOR_SIGMA[0]),
+                sy: v[1].sqrt().max(MIN_PRIOR_SIGMA[1]),
+                st: v[2].sqrt().max(MIN_PRIOR_SIGMA[2]),
+            };
+            let prior = &prior;
             // Each particle's match is independent of the others': computed in parallel, collected in order,
-            // so results do not depend on the number of threads.
-            let results: Vec<(Xyt, f64, f64)> = self
+            // so results do not depend on the number of threads (the scratch holds only rebuilt data).
+            let results: Vec<MatchResult> = self
                 .particles
                 .par_iter()
-                .map(|part| {
-                    let (corrected, score) = if guard {
-                        let guarded = matcher.beams_in_map(&part.map, &part.pose, beams);
-                        matcher.optimize(&part.map, &part.pose, &guarded)
-                    } else {
-                        matcher.optimize(&part.map, &part.pose, beams)
-                    };
-                    let pose = if score > min_score { corrected } else { part.pose };
-                    let e = matcher.likelihood_and_score(&part.map, &pose, beams);
-                    (pose, score, e.likelihood)
+                .map_init(Scratch::default, |scratch, part| {
+                    matcher.match_scan(&part.map, &part.pose, prepared, Some(prior), scratch)
                 })
                 .collect();
-            for (part, (pose, score, likelihood)) in self.particles.iter_mut().zip(results) {
-                if score > min_score {
+            for (part, m) in self.particles.iter_mut().zip(results) {
+                if m.accepted {
                     matched_particles += 1;
                 }
-                part.pose = pose;
-                score_sum += score;
-                part.weight += likelihood;
-                part.weight_sum += likelihood;
+                part.pose = m.pose;
+                score_sum += m.score;
+                part.weight += m.likelihood;
+                part.weight_sum += m.likelihood;
             }
             let gain = 1.0 / (self.params.ogain * n as f64);
             let logw: Vec<f64> = self.particles.iter().map(|q| q.weight).collect();
@@ -353,12 +354,27 @@ impl Rbpf {
         self.neff = crate::resample::neff(&self.weights);
         self.resampled_last = resampled;
 
-        // Map the scan in every particle and extend its trajectory.
+        // Map the scan in every particle and extend its trajectory (in parallel: each particle's map is its
+        // own). The seen band of a beam whose end point lies within half a cell of the last banded beam's
+        // adds nothing at this resolution and is skipped (the same beams for every particle).
         let shared_scan = Arc::new(scan.clone());
         let band = self.params.seen_band;
-        let behind = band;
-        for part in &mut self.particles {
-            let lp = self.matcher.laser_pose(&part.pose);
+        let mut banded = vec![false; prepared.hits.len()];
+        if band > 0.0 {
+            let gap = 0.5 * self.params.delta;
+            let mut last: Option<(f64, f64)> = None;
+            for (flag, b) in banded.iter_mut().zip(&prepared.hits) {
+                if last.is_none_or(|(x, y)| (b.x - x) * (b.x - x) + (b.y - y) * (b.y - y) >= gap * gap) {
+                    *flag = true;
+                    last = Some((b.x, b.y));
+                }
+            }
+        }
+        let matcher = &self.matcher;
+        let hits = &prepared.hits;
+        let banded = &banded;
+        let mapped: Result<(), SlamError> = self.particles.par_iter_mut().try_for_each(|part| {
+            let lp = matcher.laser_pose(&part.pose);
             let (s, c) = lp.t.sin_cos();
             let too_large = |part: &Particle| {
                 SlamError::MapTooLarge(format!(
@@ -366,15 +382,15 @@ impl Rbpf {
                     part.pose.x, part.pose.y
                 ))
             };
-            for b in &prepared.hits {
+            for (b, &band_it) in hits.iter().zip(banded) {
                 let (dx, dy) = (c * b.c - s * b.s, s * b.c + c * b.s);
                 let (ex, ey) = (lp.x + b.r * dx, lp.y + b.r * dy);
-                if band > 0.0 {
+                if band_it {
                     let r0 = (b.r - band).max(0.0);
                     let (x0, y0) = (lp.x + r0 * dx, lp.y + r0 * dy);
-                    part.map.mark_seen(x0, y0, ex + behind * dx, ey + behind * dy).map_err(|_| too_large(part))?;
+                    part.map.mark_seen(x0, y0, ex + band * dx, ey + band * dy).map_err(|_| too_large(part))?;
                 }
-                part.map.add_hit(ex, ey).map_err(|_| too_large(part))?;
+                part.map.add_beam_hit(ex, ey, dx, dy).map_err(|_| too_large(part))?;
             }
             part.node = Some(Arc::new(TrajectoryNode {
                 stamp: scan.stamp,
@@ -382,9 +398,12 @@ impl Rbpf {
                 scan: shared_scan.clone(),
                 parent: part.node.take(),
             }));
-        }
+            Ok(())
+        });
+        mapped?;
         self.linear_distance = 0.0;
         self.angular_distance = 0.0;
+        self.motion_var = [0.0; 3];
         self.last_update_stamp = scan.stamp;
         self.counters.processed += 1;
         Ok(UpdateOutcome::Processed(UpdateStats {
@@ -438,10 +457,21 @@ impl Rbpf {
 
     /// The best particle's path: (stamp, robot pose in the map frame) per processed scan, oldest first.
     pub fn trajectory(&self) -> Vec<(f64, Pose2)> {
-        let mut v: Vec<(f64, Pose2)> =
-            ancestry(&self.particles[self.best_index()].node).map(|n| (n.stamp, to_pose(&n.pose))).collect();
+        self.particle_trajectory(self.best_index())
+    }
+
+    /// Particle `i`'s path (see [`Rbpf::trajectory`]); empty when there is no such particle.
+    pub fn particle_trajectory(&self, i: usize) -> Vec<(f64, Pose2)> {
+        let Some(p) = self.particles.get(i) else { return Vec::new() };
+        let mut v: Vec<(f64, Pose2)> = ancestry(&p.node).map(|n| (n.stamp, to_pose(&n.pose))).collect();
         v.reverse();
         v
+    }
+
+    /// Each particle's accumulated log-likelihood over its lineage (GMapping's `weightSum`; the best
+    /// particle has the highest).
+    pub fn lineage_log_likelihoods(&self) -> Vec<f64> {
+        self.particles.iter().map(|p| p.weight_sum).collect()
     }
 
     /// The best particle's map as a log-odds grid (occupied +2, free −2, unknown 0; see [`crate::map_build`]).

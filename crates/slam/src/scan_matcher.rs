@@ -1,14 +1,23 @@
-//! GMapping's scan matcher: the score, the likelihood and the hill-climbing optimiser (`scanmatcher.cpp`).
+//! The scan matchers: GMapping's (`scanmatcher.cpp`: the score, the likelihood and the hill-climbing
+//! optimiser) and the likelihood-field matcher of the presets.
 //!
-//! For each beam end point the matcher looks, in a (2k+1)² window of cells around it, for an occupied cell
-//! whose neighbour one step back along the beam is free (so the beam could have reached it); of those it
-//! takes the one whose mean hit position is nearest, at distance d, and adds `exp(-d²/sigma)` to the score and
-//! `-d²/lsigma` to the log-likelihood (a beam with no such cell adds `-0.5/lsigma`). "Occupied" means the cell
-//! has hits in the particle's [`TileMap`]; "free" means it has none (GMapping with `generateMap` off, where an
-//! unknown cell counts as free too). The optimiser climbs from the motion-model pose with steps
-//! lstep/astep over six moves (±x, ±y in the map frame, ±θ), halving the steps each time no move improves
-//! the score, until `iterations` halvings brought nothing.
+//! **GMapping's** ([`MatcherKind::Gmapping`], the default): for each beam end point the matcher looks, in a
+//! (2k+1)² window of cells around it, for an occupied cell whose neighbour one step back along the beam is
+//! free (so the beam could have reached it); of those it takes the one whose mean hit position is nearest, at
+//! distance d, and adds `exp(-d²/sigma)` to the score and `-d²/lsigma` to the log-likelihood (a beam with no
+//! such cell adds `-0.5/lsigma`). "Occupied" means the cell has hits in the particle's [`TileMap`]; "free"
+//! means it has none (GMapping with `generateMap` off, where an unknown cell counts as free too). The
+//! optimiser climbs from the motion-model pose with steps lstep/astep over six moves (±x, ±y in the map frame,
+//! ±θ), halving the steps each time no move improves the score, until `iterations` halvings brought nothing.
+//!
+//! **The likelihood field** ([`MatcherKind::Field`]): per particle and update a [`Field`] of surfels is built
+//! once around the scan; a beam's distance d is then one table read. The pose is the mode of the scan score
+//! times the motion model (`motion_prior`): a correlative search over headings (`heading_search`), the hill
+//! climb on the field, then Gauss-Newton (iteratively reweighted least squares with the score's own weights
+//! exp(-d²/sigma)) to the optimum. The score and likelihood formulas are GMapping's.
 
+use crate::field::{Field, Lookup, Surfel};
+use crate::params::SlamParams;
 use crate::tile_map::{TILE, TILE_SHIFT, TileMap, local};
 use mrslam_core::LaserScan;
 
@@ -29,7 +38,50 @@ pub struct Xyt {
     pub t: f64,
 }
 
-/// One beam in the laser frame: range and unit direction.
+/// Metres around the scan's end points (at the starting pose) that the likelihood field covers beyond them:
+/// how far the optimiser may move an end point and still find the field.
+const FIELD_MARGIN: f64 = 0.5;
+
+/// Gauss-Newton stops when a step moves less than this (metres, and radians).
+const REFINE_TOLERANCE: f64 = 1e-4;
+/// The `field` matcher's heading search scores every this-many-th matched beam.
+const SWEEP_STRIDE: usize = 4;
+/// The `field` matcher's hill climb scores every this-many-th matched beam.
+const CLIMB_STRIDE: usize = 2;
+
+/// Which scan matcher scores poses.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum MatcherKind {
+    /// GMapping's: per beam and pose, a (2k+1)² kernel search for the nearest cell mean with a free cell
+    /// behind it; hill climbing.
+    #[default]
+    Gmapping,
+    /// A likelihood field of surfels built once per particle and update ([`crate::field`]): one table read
+    /// per beam; hill climbing on it, then Gauss-Newton refinement (`refine_iterations`).
+    Field,
+}
+
+impl std::str::FromStr for MatcherKind {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s.trim() {
+            "gmapping" => Ok(MatcherKind::Gmapping),
+            "field" => Ok(MatcherKind::Field),
+            other => Err(format!("unknown matcher '{other}' (expected gmapping or field)")),
+        }
+    }
+}
+
+impl std::fmt::Display for MatcherKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            MatcherKind::Gmapping => "gmapping",
+            MatcherKind::Field => "field",
+        })
+    }
+}
+
+/// One beam in the laser frame: range, unit direction and end point.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Beam {
     /// Range, metres.
@@ -38,6 +90,18 @@ pub struct Beam {
     pub c: f64,
     /// sin of the beam angle in the laser frame.
     pub s: f64,
+    /// End point x in the laser frame (`r·c`), metres.
+    pub x: f64,
+    /// End point y in the laser frame (`r·s`), metres.
+    pub y: f64,
+}
+
+impl Beam {
+    /// The beam of range `r` at angle `a` (laser frame).
+    pub fn new(r: f64, a: f64) -> Self {
+        let (s, c) = a.sin_cos();
+        Beam { r, c, s, x: r * c, y: r * s }
+    }
 }
 
 /// A scan prepared for matching and mapping.
@@ -66,8 +130,7 @@ impl PreparedScan {
             if r >= max_range || r > max_urange {
                 continue;
             }
-            let a = scan.angle(i);
-            let b = Beam { r, c: a.cos(), s: a.sin() };
+            let b = Beam::new(r, scan.angle(i));
             if r < max_urange {
                 out.hits.push(b);
             }
@@ -99,6 +162,101 @@ pub struct ScanMatcher {
     /// Score of a beam ending unmatched in never-seen space; `None`: 0, as GMapping (see
     /// [`crate::SlamParams::seen_band`]).
     pub unknown_score: Option<f64>,
+    /// Which matcher.
+    pub kind: MatcherKind,
+    /// `field` matcher: reach of the likelihood field, cells.
+    pub field_reach: i32,
+    /// `field` matcher: measure to surface segments (true) or to cell means (false).
+    pub field_lines: bool,
+    /// `field` matcher: Gauss-Newton iterations after the hill climb.
+    pub refine_iterations: u32,
+    /// Weigh particles with every beam (true) or the matched (every lskip+1-th) beams only (false).
+    pub weight_all_beams: bool,
+    /// `field` matcher: half-width of the correlative heading search before the climb, radians (0: off).
+    pub heading_search: f64,
+    /// `field` matcher: step of the heading search, radians.
+    pub heading_step: f64,
+    /// `field` matcher: weight of the motion-model prior (0: none; see [`MotionPrior`]).
+    pub motion_prior: f64,
+    /// The matched pose replaces the starting pose only when its score exceeds this.
+    pub minimum_score: f64,
+    /// GMapping matcher: match only the beams that find a cell at the starting pose (see
+    /// [`ScanMatcher::beams_in_map`]).
+    pub frontier_guard: bool,
+}
+
+/// A Gaussian prior on a particle's pose for the `field` matcher: the motion model's spread (standard
+/// deviations in the robot frame) around the particle's motion-model sample. Matching then finds the
+/// mode of the posterior (scan likelihood × motion model) rather than of the scan likelihood alone, so
+/// a direction the scan does not observe (along a featureless corridor, say) keeps the motion model's
+/// sample instead of drifting with small model errors.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MotionPrior {
+    /// Standard deviation along the robot's x axis, metres.
+    pub sx: f64,
+    /// Standard deviation along the robot's y axis, metres.
+    pub sy: f64,
+    /// Standard deviation of the heading, radians.
+    pub st: f64,
+}
+
+impl MotionPrior {
+    /// The information matrix (upper triangle 00 01 02 11 12 22) in the map frame for a robot at heading
+    /// `t`, scaled by `weight`.
+    fn information(&self, t: f64, weight: f64) -> [f64; 6] {
+        let (s, c) = t.sin_cos();
+        let (ix, iy) = (weight / (self.sx * self.sx), weight / (self.sy * self.sy));
+        [c * c * ix + s * s * iy, c * s * (ix - iy), 0.0, s * s * ix + c * c * iy, 0.0, weight / (self.st * self.st)]
+    }
+}
+
+/// A Gaussian prior on the pose: information matrix (map frame, upper triangle 00 01 02 11 12 22) and centre.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PosePrior {
+    /// Information matrix.
+    pub info: [f64; 6],
+    /// Centre (the prior's mean).
+    pub centre: Xyt,
+}
+
+impl PosePrior {
+    /// Half the squared Mahalanobis distance of `q` from the centre.
+    #[inline]
+    pub fn penalty(&self, q: &Xyt) -> f64 {
+        let d = self.delta(q);
+        let h = &self.info;
+        0.5 * (h[0] * d[0] * d[0]
+            + 2.0 * h[1] * d[0] * d[1]
+            + 2.0 * h[2] * d[0] * d[2]
+            + h[3] * d[1] * d[1]
+            + 2.0 * h[4] * d[1] * d[2]
+            + h[5] * d[2] * d[2])
+    }
+
+    #[inline]
+    fn delta(&self, q: &Xyt) -> [f64; 3] {
+        [q.x - self.centre.x, q.y - self.centre.y, mrslam_core::pose::normalize_angle(q.t - self.centre.t)]
+    }
+}
+
+/// Per-thread working memory of the matcher (the likelihood field), reused between particles.
+#[derive(Debug, Clone, Default)]
+pub struct Scratch {
+    /// The field of the particle being matched.
+    pub field: Field,
+}
+
+/// Outcome of matching one particle's scan.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MatchResult {
+    /// The pose to keep: the matched pose when its score exceeds the minimum, else the starting pose.
+    pub pose: Xyt,
+    /// The matched pose's score.
+    pub score: f64,
+    /// Log-likelihood of the scan at `pose`.
+    pub likelihood: f64,
+    /// Whether the matched pose was accepted (score > minimum score).
+    pub accepted: bool,
 }
 
 /// Result of evaluating a pose: score, log-likelihood and the number of beams that matched.
@@ -112,7 +270,223 @@ pub struct Evaluation {
     pub matched: usize,
 }
 
+/// Samples of exp(-t) per unit of t in [`exp_neg`]'s table.
+const EXP_STEPS: f64 = 64.0;
+/// Largest t tabulated; exp(-t) is taken as 0 beyond (exp(-16) ≈ 1e-7).
+const EXP_MAX: f64 = 16.0;
+
+/// exp(-t) for t ≥ 0 by linear interpolation in a table (relative error below 4e-5): the kernel of the
+/// `field` matcher's score, a third of whose time the libm `exp` took. Deterministic on every platform.
+#[inline]
+pub fn exp_neg(t: f64) -> f64 {
+    static TABLE: std::sync::OnceLock<Vec<f64>> = std::sync::OnceLock::new();
+    let table = TABLE
+        .get_or_init(|| (0..=(EXP_MAX * EXP_STEPS) as usize + 1).map(|i| (-(i as f64) / EXP_STEPS).exp()).collect());
+    if t.is_nan() || t >= EXP_MAX {
+        return 0.0;
+    }
+    let x = t.max(0.0) * EXP_STEPS;
+    let i = x as usize;
+    let f = x - i as f64;
+    table[i] + f * (table[i + 1] - table[i])
+}
+
 impl ScanMatcher {
+    /// The matcher configured by `params`, for a laser mounted at `laser` on the robot.
+    pub fn from_params(params: &SlamParams, laser: Xyt) -> Self {
+        ScanMatcher {
+            laser,
+            sigma: params.sigma,
+            lsigma: params.lsigma,
+            kernel_size: params.kernel_size,
+            lstep: params.lstep,
+            astep: params.astep,
+            iterations: params.iterations,
+            unknown_score: (params.seen_band > 0.0).then_some(params.unknown_score),
+            kind: params.matcher,
+            field_reach: params.field_reach,
+            field_lines: params.field_lines,
+            refine_iterations: params.refine_iterations,
+            weight_all_beams: params.weight_all_beams,
+            heading_search: params.heading_search,
+            heading_step: params.heading_step,
+            motion_prior: params.motion_prior,
+            minimum_score: params.minimum_score,
+            frontier_guard: params.frontier_guard,
+        }
+    }
+
+    /// Matches `scan` on `map` from `init` (the motion model's pose) and computes the likelihood at the
+    /// resulting pose (the matched pose when its score exceeds `minimum_score`, else `init`).
+    pub fn match_scan(
+        &self,
+        map: &TileMap,
+        init: &Xyt,
+        scan: &PreparedScan,
+        prior: Option<&MotionPrior>,
+        scratch: &mut Scratch,
+    ) -> MatchResult {
+        let weigh = if self.weight_all_beams { &scan.hits } else { &scan.matched };
+        match self.kind {
+            MatcherKind::Gmapping => {
+                let (corrected, score) = if self.frontier_guard {
+                    let guarded = self.beams_in_map(map, init, &scan.matched);
+                    self.optimize(map, init, &guarded)
+                } else {
+                    self.optimize(map, init, &scan.matched)
+                };
+                let accepted = score > self.minimum_score;
+                let pose = if accepted { corrected } else { *init };
+                let e = self.likelihood_and_score(map, &pose, weigh);
+                MatchResult { pose, score, likelihood: e.likelihood, accepted }
+            }
+            MatcherKind::Field => {
+                self.build_field(map, init, scan, &mut scratch.field);
+                let f = &scratch.field;
+                let prior = prior
+                    .filter(|_| self.motion_prior > 0.0)
+                    .map(|m| PosePrior { info: m.information(init.t, self.motion_prior), centre: *init });
+                let penalty = |q: &Xyt| prior.as_ref().map_or(0.0, |p| p.penalty(q));
+                let objective = |q: &Xyt| self.field_eval(f, q, &scan.matched).score - penalty(q);
+                // The heading search and the climb only pick the basin and approach its optimum, which the
+                // Gauss-Newton refinement then reaches on every matched beam: they use fewer beams.
+                let sparse: Vec<Beam> = scan.matched.iter().step_by(SWEEP_STRIDE).copied().collect();
+                let start = self.sweep_heading(init, |q| self.field_eval(f, q, &sparse).score - penalty(q));
+                let coarse: Vec<Beam> = scan.matched.iter().step_by(CLIMB_STRIDE).copied().collect();
+                let (mut best, _) = self.climb(&start, |q| self.field_eval(f, q, &coarse).score - penalty(q));
+                let mut score = objective(&best);
+                if self.refine_iterations > 0 {
+                    let r = self.refine(f, &best, &scan.matched, prior.as_ref());
+                    let sr = self.field_eval(f, &r, &scan.matched).score - penalty(&r);
+                    if sr > score {
+                        best = r;
+                        score = sr;
+                    }
+                }
+                let accepted = score > self.minimum_score;
+                let pose = if accepted { best } else { *init };
+                let e = self.field_eval(f, &pose, weigh);
+                MatchResult { pose, score, likelihood: e.likelihood, accepted }
+            }
+        }
+    }
+
+    /// Builds `field` for `map` around the end points of `scan` at robot pose `p`.
+    pub fn build_field(&self, map: &TileMap, p: &Xyt, scan: &PreparedScan, field: &mut Field) {
+        let lp = self.laser_pose(p);
+        let (s, c) = lp.t.sin_cos();
+        let (mut x0, mut y0, mut x1, mut y1) = (lp.x, lp.y, lp.x, lp.y);
+        for b in scan.hits.iter().chain(&scan.matched) {
+            let (px, py) = (lp.x + c * b.x - s * b.y, lp.y + s * b.x + c * b.y);
+            x0 = x0.min(px);
+            y0 = y0.min(py);
+            x1 = x1.max(px);
+            y1 = y1.max(py);
+        }
+        let (a, b) = map.cell_of(x0 - FIELD_MARGIN, y0 - FIELD_MARGIN);
+        let (c, d) = map.cell_of(x1 + FIELD_MARGIN, y1 + FIELD_MARGIN);
+        field.build(map, [a, b, c, d], self.field_reach, self.field_lines);
+    }
+
+    /// Score, log-likelihood and matched beams of robot pose `p` on a likelihood field.
+    #[inline]
+    pub fn field_eval(&self, f: &Field, p: &Xyt, beams: &[Beam]) -> Evaluation {
+        let lp = self.laser_pose(p);
+        let (s, c) = lp.t.sin_cos();
+        let (ox, oy) = f.origin();
+        let (lx, ly) = (lp.x - ox, lp.y - oy);
+        let inv_sigma = 1.0 / self.sigma;
+        let inv_lsigma = 1.0 / self.lsigma;
+        let unknown = self.unknown_score;
+        let mut e = Evaluation::default();
+        for b in beams {
+            let u = lx + c * b.x - s * b.y;
+            let v = ly + s * b.x + c * b.y;
+            match f.lookup(u, v, c * b.c - s * b.s, s * b.c + c * b.s) {
+                Lookup::Hit(d2) => {
+                    e.score += exp_neg(d2 * inv_sigma);
+                    e.likelihood -= d2 * inv_lsigma;
+                    e.matched += 1;
+                }
+                Lookup::Unseen if unknown.is_some() => e.score += unknown.unwrap_or(0.0),
+                _ => e.likelihood += NULL_LIKELIHOOD * inv_lsigma,
+            }
+        }
+        e
+    }
+
+    /// Gauss-Newton refinement of robot pose `p` on a likelihood field: iteratively reweighted least squares
+    /// of the beams' distances to their surfels with the score's own weights exp(-d²/sigma), i.e. Newton
+    /// steps towards the nearest maximum of the score.
+    pub fn refine(&self, f: &Field, p: &Xyt, beams: &[Beam], prior: Option<&PosePrior>) -> Xyt {
+        let (ox, oy) = f.origin();
+        let inv_sigma = 1.0 / self.sigma;
+        // residuals in metres with the kernel's variance sigma/2: weights w·2/sigma in chi-square units
+        let scale = 2.0 * inv_sigma;
+        let mut p = *p;
+        for _ in 0..self.refine_iterations {
+            let lp = self.laser_pose(&p);
+            let (s, c) = lp.t.sin_cos();
+            let (lx, ly) = (lp.x - ox, lp.y - oy);
+            let (rx, ry) = (p.x - ox, p.y - oy);
+            let mut h = [0.0f64; 6]; // upper triangle of the 3x3 normal matrix: 00 01 02 11 12 22
+            let mut g = [0.0f64; 3];
+            let mut add = |j: [f64; 3], r: f64, w: f64| {
+                let w = w * scale;
+                h[0] += w * j[0] * j[0];
+                h[1] += w * j[0] * j[1];
+                h[2] += w * j[0] * j[2];
+                h[3] += w * j[1] * j[1];
+                h[4] += w * j[1] * j[2];
+                h[5] += w * j[2] * j[2];
+                g[0] += w * j[0] * r;
+                g[1] += w * j[1] * r;
+                g[2] += w * j[2] * r;
+            };
+            for b in beams {
+                let u = lx + c * b.x - s * b.y;
+                let v = ly + s * b.x + c * b.y;
+                let Some((sf, d2)) = f.nearest(u, v, c * b.c - s * b.s, s * b.c + c * b.s) else { continue };
+                let w = exp_neg(d2 * inv_sigma);
+                let (ex, ey) = (u - sf.mx as f64, v - sf.my as f64);
+                // d(end point)/d(theta)
+                let (tx, ty) = (-(v - ry), u - rx);
+                if sf.kind & Surfel::LINE == 0 {
+                    add([1.0, 0.0, tx], ex, w);
+                    add([0.0, 1.0, ty], ey, w);
+                    continue;
+                }
+                let (nx, ny) = sf.normal();
+                let half = f.half(sf);
+                add([nx, ny, nx * tx + ny * ty], nx * ex + ny * ey, w);
+                let along = -ny * ex + nx * ey;
+                let over = along.abs() - half;
+                if over > 0.0 {
+                    let sg = along.signum();
+                    add([-ny * sg, nx * sg, sg * (-ny * tx + nx * ty)], over, w);
+                }
+            }
+            if let Some(pr) = prior {
+                let d = pr.delta(&p);
+                let i = &pr.info;
+                for k in 0..6 {
+                    h[k] += i[k];
+                }
+                g[0] += i[0] * d[0] + i[1] * d[1] + i[2] * d[2];
+                g[1] += i[1] * d[0] + i[3] * d[1] + i[4] * d[2];
+                g[2] += i[2] * d[0] + i[4] * d[1] + i[5] * d[2];
+            }
+            let Some(d) = solve3(&h, &g) else { break };
+            p.x -= d[0];
+            p.y -= d[1];
+            p.t -= d[2];
+            if d[0].abs() + d[1].abs() < REFINE_TOLERANCE && d[2].abs() < REFINE_TOLERANCE {
+                break;
+            }
+        }
+        p
+    }
+
     /// The laser's pose in the map frame for robot pose `p`.
     #[inline]
     pub fn laser_pose(&self, p: &Xyt) -> Xyt {
@@ -255,9 +629,36 @@ impl ScanMatcher {
 
     /// GMapping's `optimize`: hill-climbs from `init`; returns the best pose and its score.
     pub fn optimize(&self, map: &TileMap, init: &Xyt, beams: &[Beam]) -> (Xyt, f64) {
+        self.climb(init, |q| self.score(map, q, beams))
+    }
+
+    /// The correlative heading search: scores `init` turned by every multiple of `heading_step` within
+    /// ±`heading_search` and returns the best (the smallest turn on ties); `init` when the search is off.
+    pub fn sweep_heading(&self, init: &Xyt, score: impl Fn(&Xyt) -> f64) -> Xyt {
+        if !(self.heading_search > 0.0 && self.heading_step > 0.0) {
+            return *init;
+        }
+        let k = (self.heading_search / self.heading_step).floor() as i32;
+        let mut best = (score(init), *init);
+        for i in 1..=k {
+            for sign in [-1.0, 1.0] {
+                let q = Xyt { t: init.t + sign * i as f64 * self.heading_step, ..*init };
+                let s = score(&q);
+                if s > best.0 {
+                    best = (s, q);
+                }
+            }
+        }
+        best.1
+    }
+
+    /// GMapping's hill climbing on any score: from `init`, steps lstep/astep over six moves (±x, ±y in the
+    /// map frame, ±θ), halving the steps each time no move improves the score, until `iterations` halvings
+    /// brought nothing. Returns the best pose and its score.
+    pub fn climb(&self, init: &Xyt, score: impl Fn(&Xyt) -> f64) -> (Xyt, f64) {
         let mut best_score = -1.0;
         let mut current = *init;
-        let mut current_score = self.score(map, &current, beams);
+        let mut current_score = score(&current);
         let (mut ldelta, mut adelta) = (self.lstep, self.astep);
         let mut refinement = 0;
         // Bounded like GMapping's loop is in practice: each round improves the score or halves the steps.
@@ -280,7 +681,7 @@ impl ScanMatcher {
                     4 => q.t += adelta,
                     _ => q.t -= adelta,
                 }
-                let s = self.score(map, &q, beams);
+                let s = score(&q);
                 if s > current_score {
                     current_score = s;
                     best_local = q;
@@ -294,6 +695,30 @@ impl ScanMatcher {
         }
         (current, best_score.max(current_score))
     }
+}
+
+/// Solves the symmetric 3x3 system H·x = g (H given as its upper triangle 00 01 02 11 12 22); None when
+/// H is (nearly) singular.
+fn solve3(h: &[f64; 6], g: &[f64; 3]) -> Option<[f64; 3]> {
+    let (a, b, c, d, e, f) = (h[0], h[1], h[2], h[3], h[4], h[5]);
+    // cofactors
+    let c00 = d * f - e * e;
+    let c01 = c * e - b * f;
+    let c02 = b * e - c * d;
+    let det = a * c00 + b * c01 + c * c02;
+    let scale = a.abs().max(d.abs()).max(f.abs());
+    if det.is_nan() || det.abs() <= 1e-12 * scale * scale * scale || !det.is_finite() {
+        return None;
+    }
+    let c11 = a * f - c * c;
+    let c12 = b * c - a * e;
+    let c22 = a * d - b * b;
+    let inv = 1.0 / det;
+    Some([
+        (c00 * g[0] + c01 * g[1] + c02 * g[2]) * inv,
+        (c01 * g[0] + c11 * g[1] + c12 * g[2]) * inv,
+        (c02 * g[0] + c12 * g[1] + c22 * g[2]) * inv,
+    ])
 }
 
 #[cfg(test)]
@@ -310,6 +735,16 @@ mod tests {
             astep: 0.05,
             iterations: 5,
             unknown_score: None,
+            kind: MatcherKind::Gmapping,
+            field_reach: 3,
+            field_lines: true,
+            refine_iterations: 0,
+            weight_all_beams: false,
+            heading_search: 0.0,
+            heading_step: 0.01,
+            motion_prior: 0.0,
+            minimum_score: 0.0,
+            frontier_guard: false,
         }
     }
 
@@ -342,7 +777,7 @@ mod tests {
                 } else {
                     f64::INFINITY
                 };
-                Beam { r: tx.min(ty), c, s }
+                Beam { r: tx.min(ty), c, s, x: tx.min(ty) * c, y: tx.min(ty) * s }
             })
             .collect()
     }

@@ -33,20 +33,35 @@ const COORD_LIMIT: f64 = (1u32 << 28) as f64;
 /// One 32×32 patch of cells.
 #[derive(Clone)]
 pub struct Tile {
-    /// End points that fell in each cell, row-major (`ly * 32 + lx`).
-    pub hits: [u32; TILE_CELLS],
+    /// End points that fell in each cell (saturating), row-major (`ly * 32 + lx`).
+    pub hits: [u16; TILE_CELLS],
     /// Mean end point of each cell, relative to the cell's lower corner, metres.
     pub mean: [[f32; 2]; TILE_CELLS],
-    /// Whether a beam's end band (see [`TileMap::mark_seen`]) crossed each cell: known space.
-    pub seen: [bool; TILE_CELLS],
+    /// Per row (`ly`), bit `lx`: whether a beam's end band (see [`TileMap::mark_seen`]) crossed the cell
+    /// (known space).
+    pub seen: [u32; TILE as usize],
+    /// Per row (`ly`), bit `lx`: whether the cell has hits (lets a scan skip empty cells by the word).
+    pub occupied: [u32; TILE as usize],
+    /// Sum of the unit directions of the beams that ended in each cell, ×[`DIR_SCALE`] (saturating): which
+    /// side the surface was seen from. Zero when unknown (hits recorded without a direction).
+    pub dir: [[i16; 2]; TILE_CELLS],
 }
+
+/// Scale of [`Tile::dir`]'s sums of unit vectors.
+pub const DIR_SCALE: f64 = 64.0;
 
 impl Tile {
     /// Heap bytes of one tile.
     pub const BYTES: usize = std::mem::size_of::<Tile>();
 
     fn empty() -> Arc<Tile> {
-        Arc::new(Tile { hits: [0; TILE_CELLS], mean: [[0.0; 2]; TILE_CELLS], seen: [false; TILE_CELLS] })
+        Arc::new(Tile {
+            hits: [0; TILE_CELLS],
+            mean: [[0.0; 2]; TILE_CELLS],
+            seen: [0; TILE as usize],
+            occupied: [0; TILE as usize],
+            dir: [[0; 2]; TILE_CELLS],
+        })
     }
 }
 
@@ -110,7 +125,7 @@ impl TileMap {
 
     /// Hits recorded in cell (ix, iy) (0 off the map).
     #[inline]
-    pub fn hits(&self, ix: i32, iy: i32) -> u32 {
+    pub fn hits(&self, ix: i32, iy: i32) -> u16 {
         match self.tile(ix >> TILE_SHIFT, iy >> TILE_SHIFT) {
             Some(t) => t.hits[local(ix, iy)],
             None => 0,
@@ -131,7 +146,7 @@ impl TileMap {
     #[inline]
     pub fn seen(&self, ix: i32, iy: i32) -> bool {
         match self.tile(ix >> TILE_SHIFT, iy >> TILE_SHIFT) {
-            Some(t) => t.seen[local(ix, iy)],
+            Some(t) => t.seen[(iy & TILE_MASK) as usize] >> (ix & TILE_MASK) & 1 != 0,
             None => false,
         }
     }
@@ -153,10 +168,10 @@ impl TileMap {
                     slot
                 }
             };
-            let i = local(ix, iy);
+            let (row, bit) = ((iy & TILE_MASK) as usize, 1u32 << (ix & TILE_MASK));
             let t = self.tiles[slot].get_or_insert_with(Tile::empty);
-            if !t.seen[i] {
-                Arc::make_mut(t).seen[i] = true;
+            if t.seen[row] & bit == 0 {
+                Arc::make_mut(t).seen[row] |= bit;
             }
         }
         Ok(())
@@ -164,6 +179,12 @@ impl TileMap {
 
     /// Records a beam end point at map-frame (x, y): one more hit for its cell, running mean updated.
     pub fn add_hit(&mut self, x: f64, y: f64) -> Result<(), TooLarge> {
+        self.add_beam_hit(x, y, 0.0, 0.0)
+    }
+
+    /// Records the end point (x, y) of a beam travelling along unit direction (dx, dy) (map frame): as
+    /// [`TileMap::add_hit`], and the direction is added to the cell's [`Tile::dir`].
+    pub fn add_beam_hit(&mut self, x: f64, y: f64, dx: f64, dy: f64) -> Result<(), TooLarge> {
         let (ix, iy) = self.cell_of(x, y);
         let (tx, ty) = (ix >> TILE_SHIFT, iy >> TILE_SHIFT);
         self.ensure(tx, ty)?;
@@ -172,11 +193,15 @@ impl TileMap {
         let i = local(ix, iy);
         let n = tile.hits[i].saturating_add(1);
         tile.hits[i] = n;
+        tile.occupied[(iy & TILE_MASK) as usize] |= 1 << (ix & TILE_MASK);
         let (ox, oy) = (x - ix as f64 * self.delta, y - iy as f64 * self.delta);
         let m = &mut tile.mean[i];
         let inv = 1.0 / n as f64;
         m[0] += ((ox - m[0] as f64) * inv) as f32;
         m[1] += ((oy - m[1] as f64) * inv) as f32;
+        let d = &mut tile.dir[i];
+        d[0] = d[0].saturating_add((dx * DIR_SCALE).round() as i16);
+        d[1] = d[1].saturating_add((dy * DIR_SCALE).round() as i16);
         Ok(())
     }
 
@@ -214,6 +239,18 @@ impl TileMap {
         self.tw = nw as i32;
         self.th = nh as i32;
         Ok(())
+    }
+
+    /// Cells covered by the tile array, `[x0, y0, x1, y1]` inclusive; None while the map is empty.
+    pub fn cell_bounds(&self) -> Option<[i32; 4]> {
+        (self.tw > 0).then(|| {
+            [
+                self.tx0 << TILE_SHIFT,
+                self.ty0 << TILE_SHIFT,
+                ((self.tx0 + self.tw) << TILE_SHIFT) - 1,
+                ((self.ty0 + self.th) << TILE_SHIFT) - 1,
+            ]
+        })
     }
 
     /// Number of tile slots (allocated or not).

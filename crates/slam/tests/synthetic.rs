@@ -93,9 +93,11 @@ fn beats_drifting_odometry_and_maps_the_office() {
         secs
     );
     assert!(odo_rms >= 0.3, "odometry must drift for this test to mean anything: {odo_rms}");
-    // The target is 0.05 m; with the `seen_band` matcher of the preset this run measures 0.097 m (0.09-0.11 m
-    // over filter seeds 1, 2, 5; GMapping's plain matcher 0.33 m): asserted is what it reliably does.
-    assert!(slam_rms <= 0.15 && slam_rms * 20.0 <= odo_rms, "SLAM RMS {slam_rms} m");
+    // The target is 0.05 m. With the preset's `field` matcher this run measures 0.065 m (0.057-0.084 m over
+    // filter seeds 1-8; the GMapping matcher of the previous preset 0.097 m, plain GMapping 0.33 m): asserted
+    // is what it reliably does. What is left is along-track error where the 240°/4 m scan sees only walls
+    // parallel to the corridor (the same run with a 360° or a 6 m lidar measures 0.004 m): see BENCHMARKS.md.
+    assert!(slam_rms <= 0.085 && slam_rms * 10.0 <= odo_rms, "SLAM RMS {slam_rms} m");
     assert!(ai >= 0.95, "acceptance index {ai}");
     assert!(compared > 10_000);
     let (free, occ, _) = map.state_counts();
@@ -111,8 +113,9 @@ fn rplidar_preset_maps_the_office_too() {
     let rms = rms_error(&f.trajectory(), &run.truth);
     let (ai, _) = acceptance_index(&f.map().unwrap(), &run.truth_map, &run.truth[0].1);
     eprintln!("rplidar office loop: RMS {rms:.4} m, acceptance {ai:.4}");
-    // Measured 0.049 m (target 0.05 m); a little margin for float differences across platforms.
-    assert!(rms <= 0.06, "{rms}");
+    // Target 0.05 m. Measured 0.0134 m (0.010-0.020 m over filter seeds 1-8; GMapping's matcher, the
+    // previous preset, 0.049 m).
+    assert!(rms <= 0.03, "{rms}");
     assert!(ai >= 0.95, "{ai}");
 }
 
@@ -149,8 +152,9 @@ fn same_seed_same_trajectory_bit_for_bit() {
 #[test]
 fn update_schedule_and_events() {
     let run = office_run(&drifting(), 2);
-    // A high threshold, so that this short run resamples: the preset's matcher keeps the weights even.
-    let params = SlamParams { resample_threshold: 0.9, ..SlamParams::hokuyo() };
+    // A sharp likelihood and a high threshold, so that this short run resamples: with GMapping's `lsigma`
+    // the weights of this run stay even (see BENCHMARKS.md).
+    let params = SlamParams { resample_threshold: 0.9, lsigma: 0.002, ..SlamParams::hokuyo() };
     let mut f = Rbpf::new(params, run.laser_offset, 1).unwrap();
     assert_eq!(f.neff(), 30.0);
     let mut processed = 0;
@@ -233,4 +237,61 @@ fn bad_input_is_refused_or_counted() {
         f.process(&run.odometry[k], &s).unwrap();
     }
     assert_eq!(f.map().unwrap().state_counts().0, 0);
+}
+
+#[test]
+fn results_do_not_depend_on_the_number_of_threads() {
+    let map = synthetic::office_map();
+    let path: Vec<Pose2> =
+        synthetic::waypoint_path(&synthetic::office_loop(), 0.05, 0.1).into_iter().take(250).collect();
+    let run = synthetic::simulate(&map, &path, 0.1, &Lidar::hokuyo(), pose(0.1, 0.0, 0.0), &drifting(), 6);
+    let on = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        // a sharp likelihood, so that resampling (and tile sharing) is part of what is compared
+        let params = SlamParams { lsigma: 0.002, ..SlamParams::hokuyo() };
+        let f = pool.install(|| run_filter(&run, params, 3));
+        let poses: Vec<(u64, u64, u64)> = f
+            .particles()
+            .map(|(p, w)| {
+                let (x, _, t) = pose_xyt(&p);
+                (x.to_bits(), t.to_bits(), w.to_bits())
+            })
+            .collect();
+        (poses, f.map().unwrap(), f.counters())
+    };
+    let one = on(1);
+    assert!(one.2.resamples > 0, "the comparison covers resampling");
+    assert_eq!(one, on(3));
+}
+
+#[test]
+fn gmappings_matcher_stays_reachable() {
+    // GMapping's defaults with the sensor's range and a short update distance: the kernel-search matcher and
+    // hill climbing, GMapping's likelihood; it must still beat the drifting odometry on the first corridor.
+    let map = synthetic::office_map();
+    let path: Vec<Pose2> =
+        synthetic::waypoint_path(&synthetic::office_loop(), 0.05, 0.1).into_iter().take(300).collect();
+    let run = synthetic::simulate(&map, &path, 0.1, &Lidar::hokuyo(), pose(0.1, 0.0, 0.0), &drifting(), 11);
+    let params = SlamParams {
+        max_range: 4.0,
+        max_urange: 4.0,
+        linear_update: 0.25,
+        angular_update: 0.25,
+        lskip: 3,
+        ..SlamParams::default()
+    };
+    assert_eq!(params.matcher, mrslam_slam::params::MatcherKind::Gmapping);
+    let f = run_filter(&run, params, 5);
+    let traj = f.trajectory();
+    let odo0 = run.odometry[0].pose;
+    let odo: Vec<(f64, Pose2)> = traj
+        .iter()
+        .map(|(s, _)| {
+            let k = run.odometry.iter().position(|o| o.stamp == *s).unwrap();
+            (*s, relative(&odo0, &run.odometry[k].pose))
+        })
+        .collect();
+    let (slam, odom) = (rms_error(&traj, &run.truth), rms_error(&odo, &run.truth));
+    eprintln!("GMapping matcher, first 15 m: RMS slam {slam:.4} m, odometry {odom:.4} m");
+    assert!(slam < 0.5 * odom, "slam {slam} odometry {odom}");
 }

@@ -1,0 +1,560 @@
+//! A likelihood field built from a particle's hit map, for the `field` scan matcher
+//! ([`crate::scan_matcher::MatcherKind::Field`]).
+//!
+//! GMapping's matcher searches, for every beam end point and every pose it tries, a (2k+1)² window of cells
+//! for the nearest cell mean. The likelihood field does that search once per particle and update instead:
+//! over a window covering the scan, every cell stores the *surface elements* (surfels) nearest to its centre
+//! within `reach` cells, so scoring a beam is one table read.
+//!
+//! A surfel is made from an occupied cell: where the means of the occupied cells around it (±2 cells,
+//! weighted by their hits) lie on a line, the cell's mean projected onto that line plus the line's normal,
+//! and a beam's distance to it is the distance to a segment one cell long each way along the line. This
+//! removes two errors of GMapping's point-to-mean distance: the ripple along a wall (the nearest mean is up to
+//! half a cell away along it, and which mean is nearest changes as the pose moves), which makes the hill
+//! climber stop in spurious optima; and the dead band of a wall lying on a cell boundary, whose hits split
+//! between two rows of cells whose means sit on either side of it. Where the neighbourhood holds a second
+//! surface (a corner), the line is refitted to the means a candidate line through the cell's own mean
+//! supports best; where no line fits, the surfel is the mean point alone.
+//!
+//! Each cell keeps the nearest surfel of two orientation classes (normals nearer the x axis, nearer the y
+//! axis), so that near a corner a beam is measured to both faces and takes the nearer, as GMapping's kernel
+//! search takes the nearest mean around the end point itself.
+//!
+//! The tiles record which side each cell's hits came from ([`crate::tile_map::Tile::dir`]); a surfel whose
+//! beams all came from one side is *oriented*, and a beam can only end on it travelling against its normal.
+//! Without this test a surface just coming out of a pillar's shadow gets matched to the pillar's far face.
+//!
+//! Cells with no surfel within reach keep whether the particle's map has seen them (see
+//! [`crate::SlamParams::seen_band`]). The field is rebuilt for each particle at each update into reused
+//! buffers ([`Field::build`]), which are never cleared: slots carry the number of the build that wrote them.
+//! It is derived data, never shared or stored; results do not depend on which buffer a build reuses.
+
+use crate::tile_map::{DIR_SCALE, TILE, TILE_SHIFT, TileMap, local};
+
+/// A surface element: the nearest occupied cell's mean (window-relative metres), the unit normal of the
+/// surface there (×[`NORMAL_SCALE`]), and what kind of surfel it is ([`Surfel::LINE`], [`Surfel::ORIENTED`]
+/// flags; [`Surfel::NONE`] for no surfel). 16 bytes.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Surfel {
+    /// Mean hit position (projected on its line for a line surfel), x, metres from the window's origin.
+    pub mx: f32,
+    /// Mean hit position, y.
+    pub my: f32,
+    /// Unit normal ×[`NORMAL_SCALE`], x. For an oriented surfel it points to the side the surface was
+    /// seen from; for a point surfel it is the mean direction back to the sensors that saw it.
+    pub nx: i16,
+    /// Unit normal ×[`NORMAL_SCALE`], y.
+    pub ny: i16,
+    /// Flags.
+    pub kind: u8,
+    /// The [`Field`] build that wrote this surfel: older ones are stale (the buffer is not cleared).
+    stamp: u16,
+}
+
+impl Surfel {
+    /// Flag: a line surfel (a segment along the line through the neighbouring means); else a point.
+    pub const LINE: u8 = 1;
+    /// Flag: the side the surface was seen from is known: beams must meet it from the front.
+    pub const ORIENTED: u8 = 2;
+    /// No surfel.
+    pub const NONE: u8 = 0x80;
+
+    /// The unit normal.
+    #[inline]
+    pub fn normal(&self) -> (f64, f64) {
+        (self.nx as f64 * INV_NORMAL_SCALE, self.ny as f64 * INV_NORMAL_SCALE)
+    }
+
+    /// Whether this slot holds no surfel of build `stamp`.
+    #[inline]
+    fn is_none(&self, stamp: u16) -> bool {
+        self.stamp != stamp || self.kind & Surfel::NONE != 0
+    }
+}
+
+/// Scale of the surfels' i16 normals.
+pub const NORMAL_SCALE: f64 = 32767.0;
+const INV_NORMAL_SCALE: f64 = 1.0 / NORMAL_SCALE;
+const EMPTY: Surfel = Surfel { mx: 0.0, my: 0.0, nx: 0, ny: 0, kind: Surfel::NONE, stamp: 0 };
+/// Largest cosine between a beam and an oriented surfel's outward normal for the beam to end on it:
+/// slightly past grazing, so that noise at grazing incidence does not flip the test.
+pub const VISIBLE_COS: f64 = 0.1;
+/// Fraction of the summed beam directions' lengths their sum must keep, along the normal, for a surface to
+/// count as seen from one side (a thin wall seen from both sides has no orientation).
+const ORIENTED_FRACTION: f64 = 0.5;
+/// Cells on each side of an occupied cell whose means estimate its surface line.
+const NORMAL_RADIUS: i32 = 2;
+/// Fewest occupied cells (the cell included) in a line fit.
+const NORMAL_MIN_CELLS: usize = 3;
+/// Largest ratio of the small to the large eigenvalue of the neighbourhood's scatter for a line.
+const LINE_RATIO: f64 = 0.03;
+/// A point surfel (no line fits) claims a cell only when nearer than a line surfel by this many squared
+/// cells: lines are the better model wherever one reaches.
+const POINT_PENALTY: f64 = 1.0;
+/// Half-length of a line surfel's segment, cells: a beam farther along the surface than this from the
+/// cell's mean is measured to the segment's end (beyond a wall's end, the distance grows).
+const SEGMENT_HALF_CELLS: f64 = 1.0;
+/// Cells from a candidate line beyond which a mean is an outlier (another surface).
+const LINE_OUTLIER: f64 = 0.3;
+/// Hits beyond which a cell's mean weighs no more in a line fit.
+const LINE_WEIGHT_CAP: u32 = 10;
+
+/// What a beam end point finds in the field.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Lookup {
+    /// A surface within reach, at squared distance d² (m²).
+    Hit(f64),
+    /// No surface within reach; the cell was seen (known space).
+    Seen,
+    /// No surface within reach; never seen (or outside the window).
+    Unseen,
+}
+
+/// The likelihood field of one particle's map over a window of cells, reused between builds.
+#[derive(Debug, Clone, Default)]
+pub struct Field {
+    /// Window origin and size in cells (map cell coordinates).
+    x0: i32,
+    y0: i32,
+    w: i32,
+    h: i32,
+    delta: f64,
+    inv_delta: f64,
+    /// Half-length of line segments, metres.
+    half: f64,
+    /// Number of the current build (mod 2^16, never 0): surfels of other builds are stale.
+    stamp: u16,
+    /// Per cell the nearest surfel of each of two orientation classes (normal nearer the x axis, nearer the y
+    /// axis; point surfels in the first): at a corner, a beam end point is measured to both faces and takes
+    /// the nearer, as GMapping's kernel search takes the nearest mean around the point itself.
+    cells: Vec<[Surfel; 2]>,
+    /// Seen flags of the window's cells, one bit per cell.
+    seen: Vec<u64>,
+    /// Build scratch: squared distance from each cell's centre to its surfels (plus the point penalty).
+    best: Vec<[f32; 2]>,
+    /// Build scratch: per cell of the padded window, 1 + index into `occupied`, or 0.
+    occ: Vec<u32>,
+    /// Build scratch: occupied cells of the padded window: padded x, padded y, mean (metres from the window's
+    /// origin), hits, summed beam directions.
+    occupied: Vec<(i32, i32, f32, f32, u32, [i16; 2])>,
+}
+
+impl Field {
+    /// Origin of the window in the map frame, metres: subtract from map-frame points before [`Field::lookup`].
+    #[inline]
+    pub fn origin(&self) -> (f64, f64) {
+        (self.x0 as f64 * self.delta, self.y0 as f64 * self.delta)
+    }
+
+    /// Window size in cells.
+    pub fn size(&self) -> (i32, i32) {
+        (self.w, self.h)
+    }
+
+    /// Index of the cell holding window-relative point (u, v), or None outside the window.
+    #[inline]
+    fn index(&self, u: f64, v: f64) -> Option<usize> {
+        let fx = u * self.inv_delta;
+        let fy = v * self.inv_delta;
+        // NaN fails this test too
+        if !(fx >= 0.0 && fy >= 0.0) {
+            return None;
+        }
+        let (ix, iy) = (fx as i32, fy as i32);
+        if ix >= self.w || iy >= self.h {
+            return None;
+        }
+        Some((iy * self.w + ix) as usize)
+    }
+
+    /// Squared distance from (u, v) to surfel `s` for a beam of direction (dx, dy); infinite when there is
+    /// no surfel or the beam would meet an oriented surface from behind.
+    #[inline]
+    fn candidate(&self, s: &Surfel, u: f64, v: f64, dx: f64, dy: f64) -> f64 {
+        if s.is_none(self.stamp) {
+            return f64::INFINITY;
+        }
+        let (nx, ny) = s.normal();
+        if s.kind & Surfel::ORIENTED != 0 && nx * dx + ny * dy > VISIBLE_COS {
+            return f64::INFINITY;
+        }
+        let ex = u - s.mx as f64;
+        let ey = v - s.my as f64;
+        if s.kind & Surfel::LINE != 0 {
+            let perp = nx * ex + ny * ey;
+            let along = ((nx * ey - ny * ex).abs() - self.half).max(0.0);
+            perp * perp + along * along
+        } else {
+            ex * ex + ey * ey
+        }
+    }
+
+    /// The surfel nearest to window-relative point (u, v) within reach that a beam of unit direction
+    /// (dx, dy) can end on, and its squared distance.
+    #[inline]
+    pub fn nearest(&self, u: f64, v: f64, dx: f64, dy: f64) -> Option<(&Surfel, f64)> {
+        let [a, b] = &self.cells[self.index(u, v)?];
+        let da = self.candidate(a, u, v, dx, dy);
+        let db = self.candidate(b, u, v, dx, dy);
+        if da <= db { da.is_finite().then_some((a, da)) } else { Some((b, db)) }
+    }
+
+    /// Half-length of a line surfel's segment, metres (0 for a point surfel).
+    #[inline]
+    pub fn half(&self, s: &Surfel) -> f64 {
+        if s.kind & Surfel::LINE != 0 { self.half } else { 0.0 }
+    }
+
+    /// What the end point (u, v) (window-relative) of a beam of unit direction (dx, dy) finds: the squared
+    /// distance to the nearest surface within reach that the beam can meet from the front, or whether its
+    /// cell was seen.
+    #[inline]
+    pub fn lookup(&self, u: f64, v: f64, dx: f64, dy: f64) -> Lookup {
+        let Some(i) = self.index(u, v) else { return Lookup::Unseen };
+        let [a, b] = &self.cells[i];
+        let d = self.candidate(a, u, v, dx, dy).min(self.candidate(b, u, v, dx, dy));
+        if d.is_finite() {
+            Lookup::Hit(d)
+        } else if self.seen[i >> 6] >> (i & 63) & 1 != 0 {
+            Lookup::Seen
+        } else {
+            Lookup::Unseen
+        }
+    }
+
+    /// Rebuilds the field of `map` over cells `[cx0, cx1] × [cy0, cy1]` (inclusive; clipped to the map's
+    /// allocated tiles), with surfels within `reach` cells of each cell's centre. `lines` off: every
+    /// surfel is a point (the cell mean), as GMapping measures.
+    pub fn build(&mut self, map: &TileMap, cells: [i32; 4], reach: i32, lines: bool) {
+        let [mut cx0, mut cy0, mut cx1, mut cy1] = cells;
+        if let Some([mx0, my0, mx1, my1]) = map.cell_bounds() {
+            cx0 = cx0.max(mx0);
+            cy0 = cy0.max(my0);
+            cx1 = cx1.min(mx1);
+            cy1 = cy1.min(my1);
+        } else {
+            cx1 = cx0 - 1;
+        }
+        self.delta = map.delta();
+        self.inv_delta = 1.0 / self.delta;
+        self.half = SEGMENT_HALF_CELLS * self.delta;
+        if cx1 < cx0 || cy1 < cy0 {
+            (self.x0, self.y0, self.w, self.h) = (0, 0, 0, 0);
+            self.cells.clear();
+            self.seen.clear();
+            return;
+        }
+        self.x0 = cx0;
+        self.y0 = cy0;
+        self.w = cx1 - cx0 + 1;
+        self.h = cy1 - cy0 + 1;
+        let n = (self.w * self.h) as usize;
+        // The buffers keep their contents between builds: a slot is valid when stamped with this build's
+        // number, so they need no clearing (half a megabyte per particle and update for a 4 m scan).
+        self.stamp = self.stamp.wrapping_add(1);
+        if self.stamp == 0 {
+            self.cells.clear();
+            self.stamp = 1;
+        }
+        if self.cells.len() < n {
+            self.cells.resize(n, [EMPTY; 2]);
+            self.best.resize(n, [f32::INFINITY; 2]);
+        }
+        self.seen.clear();
+        self.seen.resize(n.div_ceil(64), 0);
+
+        // Pass 1: occupied cells of the padded window (their means), and the seen flags of the window; both
+        // read a tile row's bit mask at a time.
+        let pad = reach + NORMAL_RADIUS;
+        let (pw, ph) = (self.w + 2 * pad, self.h + 2 * pad);
+        self.occ.clear();
+        self.occ.resize((pw * ph) as usize, 0);
+        self.occupied.clear();
+        let delta = self.delta;
+        let (px0, py0) = (cx0 - pad, cy0 - pad);
+        let (px1, py1) = (cx1 + pad, cy1 + pad);
+        // bits lo..=hi of a tile row (lo, hi in 0..32)
+        let span = |lo: i32, hi: i32| -> u32 { (u32::MAX >> (31 - hi)) & (u32::MAX << lo) };
+        for ty in (py0 >> TILE_SHIFT)..=(py1 >> TILE_SHIFT) {
+            for tx in (px0 >> TILE_SHIFT)..=(px1 >> TILE_SHIFT) {
+                let Some(tile) = map.tile(tx, ty) else { continue };
+                let (bx, by) = (tx << TILE_SHIFT, ty << TILE_SHIFT);
+                let (ya, yb) = (by.max(py0), (by + TILE - 1).min(py1));
+                let (xa, xb) = (bx.max(px0), (bx + TILE - 1).min(px1));
+                let occ_mask = span(xa - bx, xb - bx);
+                let (wa, wb) = (bx.max(cx0), (bx + TILE - 1).min(cx1));
+                let seen_mask = if wa <= wb { span(wa - bx, wb - bx) } else { 0 };
+                for iy in ya..=yb {
+                    let row = (iy - by) as usize;
+                    if iy >= cy0 && iy <= cy1 {
+                        let mut bits = tile.seen[row] & seen_mask;
+                        while bits != 0 {
+                            let ix = bx + bits.trailing_zeros() as i32;
+                            bits &= bits - 1;
+                            let i = ((iy - cy0) * self.w + (ix - cx0)) as usize;
+                            self.seen[i >> 6] |= 1 << (i & 63);
+                        }
+                    }
+                    let mut bits = tile.occupied[row] & occ_mask;
+                    while bits != 0 {
+                        let ix = bx + bits.trailing_zeros() as i32;
+                        bits &= bits - 1;
+                        let l = local(ix, iy);
+                        let m = tile.mean[l];
+                        let mx = ((ix - cx0) as f64 * delta + m[0] as f64) as f32;
+                        let my = ((iy - cy0) as f64 * delta + m[1] as f64) as f32;
+                        self.occupied.push((ix - px0, iy - py0, mx, my, tile.hits[l] as u32, tile.dir[l]));
+                        self.occ[((iy - py0) * pw + (ix - px0)) as usize] = self.occupied.len() as u32;
+                    }
+                }
+            }
+        }
+
+        // Pass 2: each occupied cell's surfel, splatted onto the cells within reach of its mean.
+        let reach2 = ((reach as f64 + 0.5) * delta).powi(2) as f32;
+        let point_penalty = (POINT_PENALTY * delta * delta) as f32;
+        let d32 = delta as f32;
+        for k in 0..self.occupied.len() {
+            let (ox, oy, mx, my, hits, dir) = self.occupied[k];
+            let mut s = Surfel { mx, my, nx: 0, ny: 0, kind: 0, stamp: self.stamp };
+            // a point surfel's normal: the mean direction back to the sensors that saw it
+            let (ddx, ddy) = (dir[0] as f64, dir[1] as f64);
+            let dlen = (ddx * ddx + ddy * ddy).sqrt();
+            if dlen > ORIENTED_FRACTION * hits as f64 * DIR_SCALE {
+                s.nx = (-ddx / dlen * NORMAL_SCALE).round() as i16;
+                s.ny = (-ddy / dlen * NORMAL_SCALE).round() as i16;
+                s.kind = Surfel::ORIENTED;
+            }
+            let mut penalty = if lines { point_penalty } else { 0.0 };
+            if lines
+                && let Some((nx, ny, c, oriented)) =
+                    self.line(ox, oy, pw, ph, NORMAL_RADIUS).or_else(|| self.line(ox, oy, pw, ph, 1))
+            {
+                penalty = 0.0;
+                // the cell's mean projected onto the line
+                let off = nx * mx as f64 + ny * my as f64 - c;
+                s = Surfel {
+                    mx: (mx as f64 - off * nx) as f32,
+                    my: (my as f64 - off * ny) as f32,
+                    nx: (nx * NORMAL_SCALE).round() as i16,
+                    ny: (ny * NORMAL_SCALE).round() as i16,
+                    kind: Surfel::LINE | if oriented { Surfel::ORIENTED } else { 0 },
+                    stamp: self.stamp,
+                };
+            }
+            let class = usize::from(s.kind & Surfel::LINE != 0 && s.ny.unsigned_abs() > s.nx.unsigned_abs());
+            // cells (window coordinates) within reach of the occupied cell
+            let (wx, wy) = (ox - pad, oy - pad);
+            let (xa, xb) = ((wx - reach).max(0), (wx + reach).min(self.w - 1));
+            let (ya, yb) = ((wy - reach).max(0), (wy + reach).min(self.h - 1));
+            for y in ya..=yb {
+                let cy = (y as f32 + 0.5) * d32 - my;
+                let row = (y * self.w) as usize;
+                for x in xa..=xb {
+                    let cx = (x as f32 + 0.5) * d32 - mx;
+                    let d2 = cx * cx + cy * cy;
+                    let i = row + x as usize;
+                    let slot = &mut self.cells[i][class];
+                    let best = &mut self.best[i][class];
+                    if d2 <= reach2 && (slot.stamp != s.stamp || d2 + penalty < *best) {
+                        *best = d2 + penalty;
+                        *slot = s;
+                    }
+                }
+            }
+        }
+    }
+
+    /// The line through the means of the occupied cells within [`NORMAL_RADIUS`] of padded cell (ox, oy),
+    /// weighted by their hits (up to [`LINE_WEIGHT_CAP`]), when they lie on a line: its unit normal n and
+    /// offset c (points x on the line have n·x = c).
+    ///
+    /// Fitting the line through the neighbourhood rather than through the cell's own mean matters where a
+    /// surface runs along a cell boundary: its hits then split between two rows of cells whose means lie on
+    /// either side of it, and matching each end point to its own row's mean makes a dead band in which the
+    /// pose is not observed.
+    fn line(&self, ox: i32, oy: i32, pw: i32, ph: i32, radius: i32) -> Option<(f64, f64, f64, bool)> {
+        // the neighbourhood's means and weights, the cell itself first, and their occupied indices
+        const MAX: usize = ((2 * NORMAL_RADIUS + 1) * (2 * NORMAL_RADIUS + 1)) as usize;
+        let mut pts = [(0.0f64, 0.0f64, 0.0f64); MAX];
+        let mut ids = [0u32; MAX];
+        let mut n = 0;
+        let own = self.occ[(oy * pw + ox) as usize];
+        for y in (oy - radius).max(0)..=(oy + radius).min(ph - 1) {
+            for x in (ox - radius).max(0)..=(ox + radius).min(pw - 1) {
+                let k = self.occ[(y * pw + x) as usize];
+                if k == 0 || n == MAX {
+                    continue;
+                }
+                let (_, _, mx, my, hits, _) = self.occupied[k as usize - 1];
+                let p = (mx as f64, my as f64, hits.min(LINE_WEIGHT_CAP) as f64);
+                if k == own {
+                    pts[n] = pts[0];
+                    ids[n] = ids[0];
+                    pts[0] = p;
+                    ids[0] = k;
+                } else {
+                    pts[n] = p;
+                    ids[n] = k;
+                }
+                n += 1;
+            }
+        }
+        // A clean fit (every mean within LINE_OUTLIER cells of the line) is the surface. Otherwise the
+        // neighbourhood holds another surface too (the other face of a corner, clutter): of the lines through
+        // the cell's own mean and each neighbour's, the one most means support is refitted to its supporters,
+        // so a corner's cells get the line of their own face rather than a tilted average of both.
+        let tol = LINE_OUTLIER * self.delta;
+        let (x0, y0, _) = pts[0];
+        if let Some((nx, ny, c)) = fit(&pts[..n], LINE_RATIO)
+            && pts[..n].iter().all(|&(x, y, _)| (nx * x + ny * y - c).abs() <= tol)
+        {
+            return Some(self.orient(nx, ny, c, &ids[..n]));
+        }
+        let mut best: Option<(f64, f64, f64)> = None;
+        for j in 1..n {
+            let (dx, dy) = (pts[j].0 - x0, pts[j].1 - y0);
+            let len = (dx * dx + dy * dy).sqrt();
+            if len < 0.5 * self.delta {
+                continue;
+            }
+            let (nx, ny) = (-dy / len, dx / len);
+            let support: f64 =
+                pts[..n].iter().filter(|&&(x, y, _)| (nx * (x - x0) + ny * (y - y0)).abs() <= tol).map(|p| p.2).sum();
+            if best.is_none_or(|b| support > b.0) {
+                best = Some((support, nx, ny));
+            }
+        }
+        let (_, nx, ny) = best?;
+        let mut kept = 0;
+        for i in 0..n {
+            let (x, y, _) = pts[i];
+            if (nx * (x - x0) + ny * (y - y0)).abs() <= tol {
+                pts[kept] = pts[i];
+                ids[kept] = ids[i];
+                kept += 1;
+            }
+        }
+        let (nx, ny, c) = fit(&pts[..kept], LINE_RATIO)?;
+        Some(self.orient(nx, ny, c, &ids[..kept]))
+    }
+
+    /// The line (n, c) with its normal turned towards the side the beams that hit occupied cells `ids`
+    /// (1-based) came from, when they came from one side: (nx, ny, c, oriented).
+    fn orient(&self, nx: f64, ny: f64, c: f64, ids: &[u32]) -> (f64, f64, f64, bool) {
+        let (mut along, mut total) = (0.0, 0.0);
+        for &k in ids {
+            let (_, _, _, _, hits, dir) = self.occupied[k as usize - 1];
+            along += nx * dir[0] as f64 + ny * dir[1] as f64;
+            total += hits as f64 * DIR_SCALE;
+        }
+        if along.abs() > ORIENTED_FRACTION * total && total > 0.0 {
+            // beams travel against the outward normal
+            let sg = if along > 0.0 { -1.0 } else { 1.0 };
+            (sg * nx, sg * ny, sg * c, true)
+        } else {
+            (nx, ny, c, false)
+        }
+    }
+}
+
+/// Weighted total-least-squares line through points (x, y, weight): unit normal, offset and total weight,
+/// when there are at least [`NORMAL_MIN_CELLS`] points and the scatter across the line is at most `ratio`
+/// times the scatter along it.
+fn fit(pts: &[(f64, f64, f64)], ratio: f64) -> Option<(f64, f64, f64)> {
+    if pts.len() < NORMAL_MIN_CELLS {
+        return None;
+    }
+    let (mut sw, mut sx, mut sy) = (0.0, 0.0, 0.0);
+    for &(x, y, w) in pts {
+        sw += w;
+        sx += w * x;
+        sy += w * y;
+    }
+    let (mx, my) = (sx / sw, sy / sw);
+    let (mut a, mut b, mut c) = (0.0, 0.0, 0.0);
+    for &(x, y, w) in pts {
+        let (dx, dy) = (x - mx, y - my);
+        a += w * dx * dx;
+        b += w * dx * dy;
+        c += w * dy * dy;
+    }
+    let mid = 0.5 * (a + c);
+    let rad = (0.25 * (a - c) * (a - c) + b * b).sqrt();
+    let (big, small) = (mid + rad, mid - rad);
+    if big.is_nan() || big <= 0.0 || small > ratio * big {
+        return None;
+    }
+    // the normal: the eigenvector of the small eigenvalue, from whichever row of (S - small·I) is larger
+    let (ex, ey) =
+        if (a - small).abs() + b.abs() >= (c - small).abs() + b.abs() { (-b, a - small) } else { (c - small, -b) };
+    let len = (ex * ex + ey * ey).sqrt();
+    if len.is_nan() || len <= 0.0 {
+        return None;
+    }
+    let (nx, ny) = (ex / len, ey / len);
+    Some((nx, ny, nx * mx + ny * my))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_wall_gives_line_surfels_and_seen_cells() {
+        let mut m = TileMap::new(0.05);
+        // a wall along y = 1.02, x in [0, 2], seen from below (beams travelling +y)
+        for i in 0..200 {
+            m.add_beam_hit(i as f64 * 0.01, 1.02, 0.0, 1.0).unwrap();
+        }
+        m.mark_seen(1.0, 0.0, 1.0, 0.9).unwrap();
+        let mut f = Field::default();
+        f.build(&m, [-10, -10, 50, 50], 3, true);
+        let (ox, oy) = f.origin();
+        let up = |f: &Field, x: f64, y: f64| f.lookup(x - ox, y - oy, 0.0, 1.0);
+        // a point 3 cm below the wall, between two cell means: distance to the segment is the perpendicular
+        match up(&f, 1.013, 0.99) {
+            Lookup::Hit(d2) => assert!((d2.sqrt() - 0.03).abs() < 1e-4, "{}", d2.sqrt()),
+            other => panic!("{other:?}"),
+        }
+        // a beam meeting the wall from behind (travelling -y) does not end on it
+        assert!(!matches!(f.lookup(1.013 - ox, 0.99 - oy, 0.0, -1.0), Lookup::Hit(_)));
+        // without lines, the distance to the nearest mean includes the offset along the wall
+        let mut g = Field::default();
+        g.build(&m, [-10, -10, 50, 50], 3, false);
+        match up(&g, 1.013, 0.99) {
+            Lookup::Hit(d2) => assert!(d2.sqrt() > 0.03 + 1e-4, "{}", d2.sqrt()),
+            other => panic!("{other:?}"),
+        }
+        // beyond reach: seen below the wall where marked, unseen elsewhere
+        assert_eq!(up(&f, 1.01, 0.3), Lookup::Seen);
+        assert_eq!(up(&f, 0.5, 0.3), Lookup::Unseen);
+        assert_eq!(f.lookup(-100.0, 0.0, 0.0, 1.0), Lookup::Unseen);
+        // beyond the wall's end the segment distance grows
+        match up(&f, 2.12, 1.02) {
+            Lookup::Hit(d2) => assert!(d2.sqrt() > 0.05, "{}", d2.sqrt()),
+            other => panic!("{other:?}"),
+        }
+    }
+
+    #[test]
+    fn a_corner_keeps_both_faces() {
+        // an L: a wall along y = 1 for x in [0, 1], and one along x = 1 for y in [0, 1]
+        let mut m = TileMap::new(0.05);
+        for i in 0..100 {
+            let t = i as f64 * 0.01;
+            m.add_beam_hit(t, 1.0, 0.0, 1.0).unwrap();
+            m.add_beam_hit(1.0, t, 1.0, 0.0).unwrap();
+        }
+        let mut f = Field::default();
+        f.build(&m, [-10, -10, 40, 40], 3, true);
+        let (ox, oy) = f.origin();
+        // near the corner, a point on each face is on that face's line
+        for (x, y, dx, dy) in [(0.96, 0.995, 0.0, 1.0), (0.995, 0.96, 1.0, 0.0)] {
+            match f.lookup(x - ox, y - oy, dx, dy) {
+                Lookup::Hit(d2) => assert!(d2.sqrt() < 0.01, "({x}, {y}): {}", d2.sqrt()),
+                other => panic!("{other:?}"),
+            }
+        }
+    }
+}
