@@ -9,6 +9,8 @@ use mrslam_merge::{
     Evidence, FusionRule, MapEncoding, MatchParams, MergeParams, MergeReport, Merger, Model, RmapMerger, RmapParams,
     SiftMerger, SiftMergerParams, merge,
 };
+use mrslam_viz::MergeView;
+use mrslam_viz::pair::record_pair;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -61,12 +63,18 @@ pub struct MergeArgs {
     /// Draw both maps side by side with the inlier matches (PNG).
     #[arg(long)]
     pub matches_png: Option<PathBuf>,
+    /// Rerun recording of the merge.
+    #[command(flatten)]
+    pub viz: super::viz::VizArgs,
 }
 
 /// Runs `mrslam merge`.
 pub fn run(args: MergeArgs) -> Result<ExitCode> {
     let a = map_io::read_ros_map(&args.a)?;
     let b = map_io::read_ros_map(&args.b)?;
+    let (name_a, name_b) = pair_names(&args.a, &args.b);
+    let recording_id = format!("merge-{name_a}-{name_b}-{}-seed{}", args.algorithm, args.seed);
+    let mut viz = args.viz.open(&recording_id, &format!("merge {name_a} + {name_b} ({})", args.algorithm))?;
     let mut params = SiftMergerParams {
         model: args.model,
         matching: MatchParams {
@@ -100,6 +108,26 @@ pub fn run(args: MergeArgs) -> Result<ExitCode> {
         draw_matches(&a, &b, &out.evidence, p)?;
     }
     print!("{}", summary(&out.report));
+    if let Some(mut rec) = viz.take() {
+        let view = MergeView {
+            algorithm: &out.report.algorithm,
+            host: &name_a,
+            other: &name_b,
+            accepted: out.report.accepted,
+            reason: out.report.reason.as_deref(),
+            matches: out.report.matches,
+            inliers: out.report.inliers,
+            transform: out.report.transform.map(|t| t.to_pose()),
+            error: None,
+            points_a: &out.evidence.points_a,
+            points_b: &out.evidence.points_b,
+            inlier_pairs: &out.evidence.inlier_pairs,
+            merged: out.merged.as_ref(),
+        };
+        record_pair(&mut rec, &a, &b, &view);
+        let stats = rec.finish()?;
+        println!("rerun:       {} ({} rows)", args.viz.describe(), stats.rows);
+    }
     match (&out.merged, &args.output) {
         (Some(g), Some(path)) => {
             map_io::write_ros_map(g, path)?;
@@ -109,6 +137,13 @@ pub fn run(args: MergeArgs) -> Result<ExitCode> {
         _ => {}
     }
     Ok(if out.report.accepted { ExitCode::SUCCESS } else { ExitCode::from(2) })
+}
+
+/// Names of the two maps in a recording: their file stems, or `a` and `b` when the stems are alike.
+fn pair_names(a: &Path, b: &Path) -> (String, String) {
+    let stem = |p: &Path| p.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+    let (sa, sb) = (stem(a), stem(b));
+    if sa.is_empty() || sb.is_empty() || sa == sb { ("a".into(), "b".into()) } else { (sa, sb) }
 }
 
 /// The human summary of a merge.

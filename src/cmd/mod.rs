@@ -7,3 +7,4 @@ pub mod merge;
 pub mod run;
 pub mod slam;
 pub mod study;
+pub mod viz;

@@ -5,6 +5,7 @@ use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use mrslam_testbed::runner::{RunOptions, run as run_scenario, write_outputs};
 use mrslam_testbed::scenario::{ALGORITHMS, Scenario};
+use mrslam_viz::RunRecorder;
 use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -26,6 +27,9 @@ pub struct RunArgs {
     /// No progress bar.
     #[arg(long)]
     pub quiet: bool,
+    /// Rerun recording of the run.
+    #[command(flatten)]
+    pub viz: super::viz::VizArgs,
 }
 
 /// Runs `mrslam run`.
@@ -44,6 +48,10 @@ pub fn run(args: RunArgs) -> Result<ExitCode> {
     // Fail before a long run if the output folder cannot be made.
     std::fs::create_dir_all(&out_dir)
         .map_err(|e| anyhow::anyhow!("{}: cannot create output folder: {e}", out_dir.display()))?;
+    // The same for the recording: a file that cannot be written, or no viewer, fails here.
+    let recording_id = format!("{}-seed{}", scenario.name, scenario.seed);
+    let name = format!("{} (seed {})", scenario.name, scenario.seed);
+    let mut viz = args.viz.open(&recording_id, &name)?.map(RunRecorder::new);
     let bar = ProgressBar::new((scenario.duration * 10.0) as u64);
     if args.quiet || !std::io::stderr().is_terminal() {
         bar.set_draw_target(ProgressDrawTarget::hidden());
@@ -60,11 +68,16 @@ pub fn run(args: RunArgs) -> Result<ExitCode> {
             bar.set_position((t * 10.0) as u64);
             bar.set_prefix(format!("{t:.0}"));
         })),
+        viz: viz.as_mut(),
     };
     let out = run_scenario(&scenario, opts)?;
     bar.finish_and_clear();
     write_outputs(&out, &out_dir)?;
     print!("{}", out.report.summary());
     println!("outputs:  {}", out_dir.display());
+    if let Some(v) = viz {
+        let stats = v.finish()?;
+        println!("rerun:    {} ({} rows in {} chunks)", args.viz.describe(), stats.rows, stats.chunks);
+    }
     Ok(ExitCode::SUCCESS)
 }

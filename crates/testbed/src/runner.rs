@@ -10,8 +10,10 @@ use mrslam_merge::{
     MatchParams, MergeOutcome, MergeParams, Merger, RmapMerger, RmapParams, SiftMerger, SiftMergerParams, TransformXyt,
     merge,
 };
-use mrslam_sim::{RobotId, Sim, SimConfig, SimError};
+use mrslam_sim::geometry::Obstacle;
+use mrslam_sim::{RobotId, Sim, SimConfig, SimError, StepEvents};
 use mrslam_slam::{Rbpf, SlamError};
+use mrslam_viz::{MergeView, RobotInfo, RunRecorder, SlamState};
 use nalgebra::Point2;
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -46,6 +48,8 @@ pub struct RunOptions<'a> {
     pub algorithms: Option<Vec<String>>,
     /// Called about once per simulated second with (simulated time, duration).
     pub progress: Option<Box<dyn FnMut(f64, f64) + 'a>>,
+    /// Records the run for the rerun viewer; `None` (the default) records and converts nothing.
+    pub viz: Option<&'a mut RunRecorder>,
 }
 
 /// Everything a run produced.
@@ -189,6 +193,10 @@ pub fn run(scenario: &Scenario, mut opts: RunOptions) -> Result<RunOutput, RunEr
             observed: vec![false; truth.width() * truth.height()],
         });
     }
+    if let Some(v) = opts.viz.as_deref_mut() {
+        let algorithms = opts.algorithms.clone().unwrap_or_else(|| scenario.merge.algorithms.clone());
+        viz_begin(v, &sim, &truth, &agents, &algorithms);
+    }
     let dt = scenario.dt;
     let mut steps = 0u64;
     let mut next_progress = 0.0;
@@ -241,6 +249,9 @@ pub fn run(scenario: &Scenario, mut opts: RunOptions) -> Result<RunOutput, RunEr
             }
             batches.push(batch);
         }
+        if let Some(v) = opts.viz.as_deref_mut() {
+            viz_step(v, steps, sim.time(), &agents, &events, &batches);
+        }
         // The two filters are independent: update them side by side.
         let (first, rest) = agents.split_at_mut(1);
         let (b0, b1) = {
@@ -250,14 +261,20 @@ pub fn run(scenario: &Scenario, mut opts: RunOptions) -> Result<RunOutput, RunEr
         let (r0, r1) = rayon::join(|| first[0].process(b0, &truth), || rest[0].process(b1, &truth));
         r0?;
         r1?;
+        if let Some(v) = opts.viz.as_deref_mut() {
+            viz_slam(v, &agents)?;
+        }
     }
     let merge_at = sim.time();
+    if let Some(v) = opts.viz.as_deref_mut() {
+        v.set_time(steps, merge_at);
+    }
 
     // Evaluation.
     let mut robots = BTreeMap::new();
     let mut maps = BTreeMap::new();
     let mut frames = BTreeMap::new();
-    for a in &agents {
+    for (k, a) in agents.iter().enumerate() {
         let map = a.slam.map().map_err(|error| RunError::Slam { robot: a.setup.name.clone(), error })?;
         let traj: Vec<Pose2> = a.slam.trajectory().into_iter().map(|(_, p)| p).collect();
         let (t0, o0) = a.processed.first().copied().unwrap_or((a.setup.start, Pose2::identity()));
@@ -286,6 +303,11 @@ pub fn run(scenario: &Scenario, mut opts: RunOptions) -> Result<RunOutput, RunEr
                 slam_s: a.slam_s,
             },
         );
+        if let Some(v) = opts.viz.as_deref_mut() {
+            // The maps and paths that are merged and evaluated, whatever the logging rates.
+            v.map(k, &map);
+            v.paths(k, &traj);
+        }
         frames.insert(a.setup.name.clone(), t0);
         maps.insert(a.setup.name.clone(), map);
     }
@@ -318,6 +340,23 @@ pub fn run(scenario: &Scenario, mut opts: RunOptions) -> Result<RunOutput, RunEr
             inliers: out.report.inliers,
             matches: out.report.matches,
         });
+        if let Some(v) = opts.viz.as_deref_mut() {
+            v.merge(&MergeView {
+                algorithm: name,
+                host: &host,
+                other: &other,
+                accepted: out.report.accepted,
+                reason: out.report.reason.as_deref(),
+                matches: out.report.matches,
+                inliers: out.report.inliers,
+                transform: out.report.transform.map(|t| t.to_pose()),
+                error: err,
+                points_a: &out.evidence.points_a,
+                points_b: &out.evidence.points_b,
+                inlier_pairs: &out.evidence.inlier_pairs,
+                merged: out.merged.as_ref(),
+            });
+        }
         merges.push(out);
     }
     let (oa, ob) = (&agents[0].observed, &agents[1].observed);
@@ -358,5 +397,74 @@ pub fn write_outputs(out: &RunOutput, dir: &Path) -> Result<(), RunError> {
     }
     let json = serde_json::to_vec_pretty(&out.report).expect("reports serialise");
     map_io::write_file_atomic(&dir.join("report.json"), &json)?;
+    Ok(())
+}
+
+// ---- rerun hooks: called only when `RunOptions::viz` is set; they hand plain data to mrslam-viz. ----
+
+/// The world's obstacles as closed outlines (circles as 24-gons).
+fn viz_walls(sim: &Sim) -> Vec<Vec<Point2<f64>>> {
+    sim.world()
+        .obstacles()
+        .iter()
+        .map(|o| match o {
+            Obstacle::Circle { center, radius } => (0..24)
+                .map(|k| {
+                    let a = k as f64 * std::f64::consts::TAU / 24.0;
+                    Point2::new(center.x + radius * a.cos(), center.y + radius * a.sin())
+                })
+                .collect(),
+            other => other.outline(),
+        })
+        .collect()
+}
+
+/// Static content and layout.
+fn viz_begin(v: &mut RunRecorder, sim: &Sim, truth: &OccupancyGrid, agents: &[Agent], algorithms: &[String]) {
+    let robots: Vec<RobotInfo> =
+        agents.iter().map(|a| RobotInfo { name: a.setup.name.clone(), start: a.setup.start }).collect();
+    v.set_time(0, sim.time());
+    v.begin(&viz_walls(sim), truth, &robots, algorithms);
+}
+
+/// A step: slip and contacts, and this step's scans with the true and odometry poses they were taken at.
+fn viz_step(
+    v: &mut RunRecorder,
+    step: u64,
+    time: f64,
+    agents: &[Agent],
+    events: &StepEvents,
+    batches: &[Vec<(LaserScan, Odometry, Pose2)>],
+) {
+    v.set_time(step, time);
+    for (k, ((a, ev), batch)) in agents.iter().zip(&events.robots).zip(batches).enumerate() {
+        v.robot_step(k, ev.slipping, ev.contact);
+        for (scan, odom, pose) in batch {
+            v.scan(k, pose, &odom.pose, scan, &a.setup.lidar.mount);
+        }
+    }
+}
+
+/// The filters after this step's updates: best pose, particles, Neff; paths and maps when due.
+fn viz_slam(v: &mut RunRecorder, agents: &[Agent]) -> Result<(), RunError> {
+    for (k, a) in agents.iter().enumerate() {
+        let state = SlamState {
+            scans: a.scans,
+            best: &a.slam.best_pose(),
+            particles: a.slam.particles(),
+            neff: a.slam.neff(),
+            resamples: a.slam.counters().resamples,
+            frame: a.processed.first().map(|p| p.0),
+        };
+        v.slam(k, state);
+        if v.paths_due(k) {
+            let traj: Vec<Pose2> = a.slam.trajectory().into_iter().map(|(_, p)| p).collect();
+            v.paths(k, &traj);
+        }
+        if v.map_due(k) {
+            let map = a.slam.map().map_err(|error| RunError::Slam { robot: a.setup.name.clone(), error })?;
+            v.map(k, &map);
+        }
+    }
     Ok(())
 }

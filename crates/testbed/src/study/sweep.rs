@@ -249,7 +249,7 @@ fn run_trial(sweep: &Sweep, scenario: &Scenario, trial: usize) -> Result<Vec<Tri
     if by_runner.is_empty() {
         by_runner.push("sift".into());
     }
-    let out = run(scenario, RunOptions { algorithms: Some(by_runner), progress: None })
+    let out = run(scenario, RunOptions { algorithms: Some(by_runner), ..RunOptions::default() })
         .map_err(|e| fail(format!("seed {}: {e}", scenario.seed)))?;
     let report = &out.report;
     let true_t = report.merges.first().map(|m| m.true_transform.to_pose()).ok_or_else(|| fail("no merge".into()))?;

@@ -1,0 +1,32 @@
+//! mrslam-viz: the testbed's runs in the rerun viewer — the only crate of the workspace that knows rerun.
+//!
+//! A [`Recorder`] writes one reproducible recording to any of its [`Target`]s: an `.rrd` file, a viewer it
+//! starts (`rerun` on PATH), or a viewer already running (gRPC). On top of it, [`RunRecorder`] records a
+//! testbed run (world, robots, particles, scans, growing maps, merges, metrics, events, and a layout) from plain
+//! data handed over by the simulation loop, and [`pair::record_pair`] a stand-alone merge of two maps.
+//! [`inspect::summarize`] reads a recording back with rerun's own decoder.
+//!
+//! Entity paths (../shared/DESIGN.md): `world/{walls,truth_map}`,
+//! `robots/<name>/{truth,truth/path,odom,odom/path,slam/pose,slam/path,slam/particles,scan}`, `maps/<name>`,
+//! `merge/<algorithm>/{keypoints/<name>,matches,merged}`, `metrics/{error,neff,slip}/...`, `events`; timelines
+//! `sim_time` (seconds) and `step`. Nothing here runs unless a recording was asked for.
+
+pub mod blueprint;
+pub mod convert;
+pub mod error;
+pub mod inspect;
+pub mod maps;
+pub mod metrics;
+pub mod pair;
+pub mod paths;
+pub mod recorder;
+pub mod robot;
+pub mod run;
+pub mod target;
+pub mod world;
+
+pub use error::VizError;
+pub use metrics::Level;
+pub use recorder::{Recorder, RecordingStats};
+pub use run::{MergeView, Rates, RobotInfo, RunRecorder, SlamState};
+pub use target::Target;

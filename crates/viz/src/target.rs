@@ -1,0 +1,132 @@
+//! Where a recording goes: an `.rrd` file, a viewer started now, or a viewer already running.
+
+use crate::error::VizError;
+use rerun::external::re_uri::RedapUri;
+use rerun::sink::{FileSink, FileSinkOptions, GrpcSink, LogSink};
+use std::path::{Path, PathBuf};
+
+/// The viewer's default gRPC proxy address.
+pub const DEFAULT_CONNECT: &str = "127.0.0.1:9876";
+
+/// One destination of a recording.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Target {
+    /// An `.rrd` file, written as the run goes and closed at the end.
+    File(PathBuf),
+    /// A rerun viewer started now from PATH (`rerun`), streamed to over gRPC.
+    Spawn,
+    /// A running viewer, by its gRPC proxy URL (`rerun+http://HOST:PORT/proxy`).
+    Connect(String),
+}
+
+impl Target {
+    /// A `--connect` target from HOST:PORT or a full `rerun+http://HOST:PORT/proxy` URL; `None` means the
+    /// viewer's default address.
+    pub fn connect(addr: Option<&str>) -> Result<Target, VizError> {
+        let addr = addr.unwrap_or(DEFAULT_CONNECT).trim();
+        let url = if addr.contains("://") { addr.to_string() } else { format!("rerun+http://{addr}/proxy") };
+        match url.parse::<RedapUri>() {
+            Ok(RedapUri::Proxy(_)) => Ok(Target::Connect(url)),
+            Ok(_) => Err(VizError::BadAddress { addr: addr.to_string(), why: "not a /proxy endpoint".into() }),
+            Err(e) => Err(VizError::BadAddress { addr: addr.to_string(), why: e.to_string() }),
+        }
+    }
+
+    /// A short human description (`file x.rrd`, `viewer at ...`).
+    pub fn describe(&self) -> String {
+        match self {
+            Target::File(p) => format!("file {}", p.display()),
+            Target::Spawn => "a new rerun viewer".to_string(),
+            Target::Connect(url) => format!("viewer at {url}"),
+        }
+    }
+
+    /// Opens the destination: creates the file, starts the viewer or dials the address.
+    pub(crate) fn open(&self) -> Result<Box<dyn LogSink>, VizError> {
+        match self {
+            Target::File(path) => open_file(path),
+            Target::Spawn => {
+                if find_on_path("rerun").is_none() {
+                    return Err(VizError::NoViewer);
+                }
+                let info = rerun::spawn(&rerun::SpawnOptions::default()).map_err(|e| VizError::Spawn(e.to_string()))?;
+                grpc(&format!("rerun+http://127.0.0.1:{}/proxy", info.port))
+            }
+            Target::Connect(url) => grpc(url),
+        }
+    }
+}
+
+fn open_file(path: &Path) -> Result<Box<dyn LogSink>, VizError> {
+    let err = |cause: String| VizError::CreateFile { path: path.to_path_buf(), cause };
+    if path.is_dir() {
+        return Err(err("it is a folder".into()));
+    }
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty())
+        && !dir.is_dir()
+    {
+        return Err(err(format!("folder {} does not exist", dir.display())));
+    }
+    // FileSink creates the file now, so a path that cannot be written fails here, before any work is done.
+    // No RRD footer: its per-store manifests come out in hash-map order (the recording and its blueprint are two
+    // stores), which would make two runs' files differ; the footer only speeds up random access to big files,
+    // and `rerun rrd optimize` can add one.
+    let options = FileSinkOptions { write_footer: false };
+    let sink = FileSink::with_options(path, options).map_err(|e| match e {
+        rerun::sink::FileSinkError::CreateFile { source, .. } => err(source.to_string()),
+        other => err(other.to_string()),
+    })?;
+    Ok(Box::new(sink))
+}
+
+fn grpc(url: &str) -> Result<Box<dyn LogSink>, VizError> {
+    match url.parse::<RedapUri>() {
+        Ok(RedapUri::Proxy(uri)) => Ok(Box::new(GrpcSink::new(uri))),
+        Ok(_) => Err(VizError::BadAddress { addr: url.to_string(), why: "not a /proxy endpoint".into() }),
+        Err(e) => Err(VizError::BadAddress { addr: url.to_string(), why: e.to_string() }),
+    }
+}
+
+/// The first executable called `name` on PATH.
+pub fn find_on_path(name: &str) -> Option<PathBuf> {
+    let path = std::env::var_os("PATH")?;
+    std::env::split_paths(&path).map(|d| d.join(name)).find(|p| is_executable(p))
+}
+
+#[cfg(unix)]
+fn is_executable(p: &Path) -> bool {
+    use std::os::unix::fs::PermissionsExt;
+    p.metadata().is_ok_and(|m| m.is_file() && m.permissions().mode() & 0o111 != 0)
+}
+
+#[cfg(not(unix))]
+fn is_executable(p: &Path) -> bool {
+    p.is_file() || p.with_extension("exe").is_file()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn connect_addresses() {
+        assert_eq!(Target::connect(None).unwrap(), Target::Connect("rerun+http://127.0.0.1:9876/proxy".into()));
+        assert_eq!(
+            Target::connect(Some("10.0.0.5:9000")).unwrap(),
+            Target::Connect("rerun+http://10.0.0.5:9000/proxy".into())
+        );
+        assert!(Target::connect(Some("rerun+http://127.0.0.1:9876/proxy")).is_ok());
+        let e = Target::connect(Some("not an address at all")).unwrap_err().to_string();
+        assert!(e.contains("not an address at all"), "{e}");
+    }
+
+    #[test]
+    fn unwritable_files_are_refused_with_the_path() {
+        let dir = tempfile::tempdir().unwrap();
+        let e = Target::File(dir.path().to_path_buf()).open().err().unwrap().to_string();
+        assert!(e.contains("it is a folder"), "{e}");
+        let missing = dir.path().join("no/such/dir/run.rrd");
+        let e = Target::File(missing.clone()).open().err().unwrap().to_string();
+        assert!(e.contains(&missing.display().to_string()) && e.contains("does not exist"), "{e}");
+    }
+}

@@ -1,0 +1,188 @@
+//! `mrslam run ... --rrd` and `mrslam merge ... --rrd`, as a user would: the recording is read back with rerun's
+//! own decoder (through `mrslam_viz::inspect`), and must hold the designed entity paths and timelines with
+//! plausible counts, identical bytes on a second run, and bad destinations must fail before any work.
+
+use mrslam_core::map_io::write_ros_map;
+use mrslam_merge::floorplan::{FloorplanParams, generate};
+use mrslam_viz::inspect::summarize;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn mrslam(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_mrslam")).args(args).output().expect("mrslam runs")
+}
+
+fn text(b: &[u8]) -> String {
+    String::from_utf8_lossy(b).into_owned()
+}
+
+fn p(path: &Path) -> &str {
+    path.to_str().unwrap()
+}
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// The two-rooms scenario cut to `seconds` of simulated time and the SIFT merge only, written into `dir`.
+fn short_scenario(dir: &Path, seconds: f64) -> PathBuf {
+    let text = std::fs::read_to_string(root().join("scenarios/paper_two_rooms.toml")).unwrap();
+    let world = root().join("worlds/two_rooms.toml");
+    for needle in ["duration = 180.0", "algorithms = [\"sift\", \"rmap\"]", "\"../worlds/two_rooms.toml\""] {
+        assert!(text.contains(needle), "the shipped scenario no longer contains `{needle}`");
+    }
+    let text = text
+        .replace("duration = 180.0", &format!("duration = {seconds:.1}"))
+        .replace("algorithms = [\"sift\", \"rmap\"]", "algorithms = [\"sift\"]")
+        .replace("\"../worlds/two_rooms.toml\"", &format!("{:?}", world.display().to_string()));
+    let path = dir.join("short.toml");
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+fn run_with_rrd(scenario: &Path, out: &Path, rrd: &Path) -> Output {
+    mrslam(&["run", p(scenario), "--quiet", "--out", p(out), "--rrd", p(rrd)])
+}
+
+#[test]
+fn run_records_the_designed_entities_and_timelines_reproducibly() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let seconds = 6.0;
+    let scenario = short_scenario(d, seconds);
+    let rrd = d.join("run.rrd");
+    let o = run_with_rrd(&scenario, &d.join("out"), &rrd);
+    assert!(o.status.success(), "{}{}", text(&o.stdout), text(&o.stderr));
+    assert!(text(&o.stdout).contains("rerun:"), "{}", text(&o.stdout));
+
+    let s = summarize(&rrd).unwrap();
+    assert_eq!(s.recordings, ["paper_two_rooms-seed11"]);
+    assert_eq!(s.blueprints.len(), 1, "{s:?}");
+    assert_eq!(s.activations, 1);
+    assert!(s.blueprint_entities.contains("/viewport"), "{:?}", s.blueprint_entities);
+    // Only the simulation's timelines: no wall-clock log_time, no log_tick.
+    assert_eq!(s.timelines.iter().map(String::as_str).collect::<Vec<_>>(), ["sim_time", "step"]);
+
+    for e in ["/world/walls", "/world/truth_map"] {
+        assert_eq!(s.static_rows.get(e), Some(&1), "{e}: {:?}", s.rows);
+    }
+    // Scans: Experia's Hokuyo at 10 Hz, Prawn's RpLidar at 5 Hz.
+    for (robot, hz) in [("experia", 10.0), ("prawn", 5.0)] {
+        let expect = seconds * hz;
+        // Rows logged over time (static rows, such as the odometry frame's placement, left out).
+        let at = |leaf: &str| {
+            let e = format!("/robots/{robot}/{leaf}");
+            s.rows_at(&e) - s.static_rows.get(&e).copied().unwrap_or(0)
+        };
+        let scans = at("scan") as f64;
+        assert!((scans - expect).abs() <= 2.0, "{robot}: {scans} scans in {seconds} s at {hz} Hz");
+        assert_eq!(at("truth"), at("scan"), "{robot}: one true pose per scan");
+        assert_eq!(at("odom"), at("scan"), "{robot}: one odometry pose per scan");
+        for leaf in ["slam/pose", "slam/particles"] {
+            let n = at(leaf);
+            assert!(n >= 1 && n <= at("scan"), "{robot} {leaf}: {n}");
+        }
+        // Paths at most every 0.5 s (plus the final one), maps at most once a second (plus the final one).
+        for (leaf, most) in [
+            ("truth/path", seconds / 0.5 + 2.0),
+            ("odom/path", seconds / 0.5 + 2.0),
+            ("slam/path", seconds / 0.5 + 2.0),
+        ] {
+            let n = at(leaf) as f64;
+            assert!(n >= 2.0 && n <= most, "{robot} {leaf}: {n} rows");
+        }
+        let maps = s.rows_at(&format!("/maps/{robot}")) as f64;
+        assert!((2.0..=seconds + 2.0).contains(&maps), "{robot}: {maps} maps");
+        assert_eq!(s.rows_at(&format!("/merge/sift/keypoints/{robot}")), 1, "{robot}");
+        for group in ["neff", "slip"] {
+            assert!(s.rows_at(&format!("/metrics/{group}/{robot}")) >= 2, "{robot} {group}: {:?}", s.rows);
+        }
+        assert!(s.rows_at(&format!("/metrics/error/{robot}/odom")) >= 2);
+    }
+    assert_eq!(s.rows_at("/merge/sift/matches"), 1);
+    assert!(s.rows_at("/events") >= 2, "run start and the merge verdict: {:?}", s.rows);
+
+    // Reproducible: a second run of the same scenario writes the same bytes.
+    let again = d.join("again.rrd");
+    let o = run_with_rrd(&scenario, &d.join("out2"), &again);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let (x, y) = (std::fs::read(&rrd).unwrap(), std::fs::read(&again).unwrap());
+    assert!(x == y, "two runs of one scenario differ ({} and {} bytes)", x.len(), y.len());
+}
+
+#[test]
+fn bad_destinations_fail_before_the_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    // A long scenario: if the destination were checked after the run, this test would take minutes.
+    let scenario = short_scenario(d, 170.0);
+    let out = d.join("out");
+    let rrd = d.join("no/such/folder/run.rrd");
+    let start = std::time::Instant::now();
+    let o = run_with_rrd(&scenario, &out, &rrd);
+    let e = text(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{e}");
+    assert!(e.contains(p(&rrd)) && e.contains("does not exist"), "{e}");
+    assert!(!e.contains("panicked"), "{e}");
+    assert!(!out.join("report.json").exists(), "the run went ahead");
+    assert!(start.elapsed().as_secs() < 20, "refused only after {:?}", start.elapsed());
+
+    // A folder in the way.
+    let o = run_with_rrd(&scenario, &out, d);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(text(&o.stderr).contains("it is a folder"), "{}", text(&o.stderr));
+
+    // --spawn with no viewer on PATH says how to get one.
+    let empty = d.join("empty-path");
+    std::fs::create_dir_all(&empty).unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_mrslam"))
+        .args(["run", p(&scenario), "--quiet", "--out", p(&out), "--spawn"])
+        .env("PATH", &empty)
+        .output()
+        .unwrap();
+    let e = text(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{e}");
+    assert!(e.contains("pip install rerun-sdk==0.36.3"), "{e}");
+
+    // --connect with something that is no address.
+    let o = mrslam(&["run", p(&scenario), "--quiet", "--out", p(&out), "--connect", "no such host at all"]);
+    let e = text(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{e}");
+    assert!(e.contains("--connect no such host at all"), "{e}");
+}
+
+#[test]
+fn merge_records_both_maps_keypoints_matches_and_the_merged_map() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    write_ros_map(&generate(21, &FloorplanParams::default()), &d.join("plan.yaml")).unwrap();
+    let o = mrslam(&[
+        "map",
+        "cut",
+        p(&d.join("plan.yaml")),
+        p(&d.join("left.yaml")),
+        p(&d.join("right.yaml")),
+        "--seed",
+        "3",
+    ]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let rrd = d.join("merge.rrd");
+    let o = mrslam(&["merge", p(&d.join("left.yaml")), p(&d.join("right.yaml")), "--rrd", p(&rrd)]);
+    assert_eq!(o.status.code(), Some(0), "{}{}", text(&o.stdout), text(&o.stderr));
+    let s = summarize(&rrd).unwrap();
+    assert_eq!(s.recordings, ["merge-left-right-sift-seed0"]);
+    for e in ["/maps/left", "/maps/right", "/merge/sift/keypoints/left", "/merge/sift/keypoints/right"] {
+        assert_eq!(s.rows_at(e), 1, "{e}: {:?}", s.rows);
+    }
+    assert_eq!(s.rows_at("/merge/sift/matches"), 1);
+    assert_eq!(s.rows_at("/merge/sift/merged"), 1, "the pair merges, so the merged map is there");
+    assert!(s.rows_at("/events") >= 1);
+    assert_eq!(s.activations, 1);
+
+    // An unwritable --rrd fails before the merge, with the path named.
+    let bad = d.join("missing/merge.rrd");
+    let o = mrslam(&["merge", p(&d.join("left.yaml")), p(&d.join("right.yaml")), "--rrd", p(&bad)]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(text(&o.stderr).contains(p(&bad)), "{}", text(&o.stderr));
+    assert!(!text(&o.stdout).contains("ACCEPTED"), "the merge ran: {}", text(&o.stdout));
+}
