@@ -125,6 +125,12 @@ pub struct Explorer {
 }
 
 impl Explorer {
+    /// Distance kept from walls beyond the robot's bounding radius, metres: planned paths hug obstacles at
+    /// exactly the clearance, and the follower cuts the corners of the grid path.
+    pub const MARGIN: f64 = 0.2;
+    /// Look-ahead of the path follower, metres (shorter than the scripted routes': frontier paths bend).
+    pub const LOOKAHEAD: f64 = 0.35;
+
     /// An explorer driving at `speed`, keeping `clearance` from walls.
     pub fn new(speed: f64, clearance: f64) -> Self {
         Explorer { clearance, replan_period: 3.0, speed, follower: None, since_plan: f64::INFINITY, finished: false }
@@ -145,7 +151,11 @@ impl Explorer {
     pub fn plan(&mut self, map: &OccupancyGrid, pose: &Pose2) {
         self.since_plan = 0.0;
         match frontier_path(map, pose, self.clearance) {
-            Some(path) => self.follower = Some(PurePursuit::new(path, self.speed)),
+            Some(path) => {
+                let mut f = PurePursuit::new(path, self.speed);
+                f.lookahead = Self::LOOKAHEAD;
+                self.follower = Some(f);
+            }
             None => {
                 self.follower = None;
                 self.finished = true;
@@ -164,6 +174,11 @@ impl Explorer {
 }
 
 /// Path (SLAM frame) to the nearest reachable frontier cell, thinned to one point every ~0.4 m.
+///
+/// A frontier cell is a free cell with at least [`FRONTIER_MIN_UNKNOWN`] unknown cells among its eight
+/// neighbours (the edge of unexplored space, not a one-cell hole between two far beams), outside the robot's
+/// own disc. The disc of radius `clearance` around the robot is passable wherever it is not occupied: the
+/// robot stands there, and a lidar does not see the cells under and behind the robot.
 pub fn frontier_path(map: &OccupancyGrid, pose: &Pose2, clearance: f64) -> Option<Vec<Point2<f64>>> {
     let (w, h) = (map.width(), map.height());
     let r = (clearance / map.resolution()).ceil() as i64;
@@ -184,20 +199,20 @@ pub fn frontier_path(map: &OccupancyGrid, pose: &Pose2, clearance: f64) -> Optio
         }
     }
     let start = map.world_to_cell(&Point2::new(pose.translation.x, pose.translation.y))?;
+    let (sx, sy) = (start.0 as i64, start.1 as i64);
+    let on_robot = |x: i64, y: i64| (x - sx).pow(2) + (y - sy).pow(2) <= r * r;
+    let state = |x: i64, y: i64| map.get_checked(x, y).map(CellState::from_log_odds);
     let s = start.1 * w + start.0;
     let mut parent = vec![usize::MAX; w * h];
     parent[s] = s;
     let mut queue = VecDeque::from([s]);
-    let min_dist = (1.0 / map.resolution()) as i64; // ignore frontiers under the robot's nose
-    let free = |x: i64, y: i64| map.state(x as usize, y as usize) == CellState::Free;
     while let Some(c) = queue.pop_front() {
         let (cx, cy) = ((c % w) as i64, (c / w) as i64);
-        let frontier = free(cx, cy)
-            && [(1, 0), (-1, 0), (0, 1), (0, -1)].iter().any(|(dx, dy)| {
-                map.get_checked(cx + dx, cy + dy).is_some_and(|l| CellState::from_log_odds(l) == CellState::Unknown)
-            });
-        let far = (cx - start.0 as i64).abs() + (cy - start.1 as i64).abs() >= min_dist;
-        if frontier && far {
+        let unknown_around = (-1..=1)
+            .flat_map(|dy| (-1..=1).map(move |dx| (dx, dy)))
+            .filter(|&(dx, dy)| state(cx + dx, cy + dy) == Some(CellState::Unknown))
+            .count();
+        if state(cx, cy) == Some(CellState::Free) && unknown_around >= FRONTIER_MIN_UNKNOWN && !on_robot(cx, cy) {
             let mut cells = vec![c];
             let mut k = c;
             while parent[k] != k {
@@ -213,12 +228,10 @@ pub fn frontier_path(map: &OccupancyGrid, pose: &Pose2, clearance: f64) -> Optio
         }
         for (dx, dy) in [(1i64, 0i64), (-1, 0), (0, 1), (0, -1)] {
             let (nx, ny) = (cx + dx, cy + dy);
-            if !map.contains_cell(nx, ny) {
-                continue;
-            }
+            let Some(st) = state(nx, ny) else { continue };
             let n = ny as usize * w + nx as usize;
-            // The start cell may sit within the clearance of a wall; let the robot leave it.
-            let passable = free(nx, ny) && (!blocked[n] || c == s);
+            let passable =
+                if on_robot(nx, ny) { st != CellState::Occupied } else { st == CellState::Free && !blocked[n] };
             if parent[n] == usize::MAX && passable {
                 parent[n] = c;
                 queue.push_back(n);
@@ -227,6 +240,9 @@ pub fn frontier_path(map: &OccupancyGrid, pose: &Pose2, clearance: f64) -> Optio
     }
     None
 }
+
+/// Unknown cells among a frontier cell's eight neighbours, at least.
+pub const FRONTIER_MIN_UNKNOWN: usize = 3;
 
 #[cfg(test)]
 mod tests {
@@ -269,5 +285,33 @@ mod tests {
             g.set(79, iy, 2.0);
         }
         assert!(frontier_path(&g, &pose(1.0, 1.0, 0.0), 0.15).is_none(), "closed door: nothing to explore");
+    }
+
+    #[test]
+    fn a_robot_that_cannot_see_behind_itself_still_finds_its_frontier() {
+        // A walled 4 m x 2 m room seen by a forward-looking lidar mounted ahead of the axle at (1.05, 1): the
+        // robot's own cell and everything behind it are unknown, and so is a one-cell hole far ahead.
+        let mut g = OccupancyGrid::new(80, 40, 0.05, pose(0.0, 0.0, 0.0)).unwrap();
+        for iy in 0..40 {
+            for ix in 0..80 {
+                let wall = ix == 0 || iy == 0 || iy == 39 || ix == 79;
+                let seen = ix > 22;
+                if wall {
+                    g.set(ix, iy, 2.0);
+                } else if seen && (ix, iy) != (60, 20) {
+                    g.set(ix, iy, -2.0);
+                }
+            }
+        }
+        let path = frontier_path(&g, &pose(1.05, 1.0, 0.0), 0.3).expect("the unseen space behind the robot");
+        let end = path.last().unwrap();
+        assert!(end.x < 1.3, "it drives to the edge of the unseen space, not to the hole: {end:?}");
+        // Once the space behind is seen, only the hole is left, and a hole is no frontier.
+        for iy in 1..39 {
+            for ix in 1..23 {
+                g.set(ix, iy, -2.0);
+            }
+        }
+        assert!(frontier_path(&g, &pose(1.05, 1.0, 0.0), 0.3).is_none());
     }
 }

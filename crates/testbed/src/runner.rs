@@ -174,7 +174,7 @@ pub fn run(scenario: &Scenario, mut opts: RunOptions) -> Result<RunOutput, RunEr
                 (Some(p), None)
             }
             ControllerKind::Explore => {
-                let clearance = r.model.footprint.bounding_radius() + 0.1;
+                let clearance = r.model.footprint.bounding_radius() + Explorer::MARGIN;
                 (None, Some(Explorer::new(r.speed, clearance)))
             }
         };
