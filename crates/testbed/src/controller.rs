@@ -1,6 +1,6 @@
 //! Controllers: pure pursuit along waypoints, and frontier exploration on the robot's own map.
 
-use mrslam_core::{CellState, OccupancyGrid, Pose2, pose_xyt};
+use mrslam_core::{CellState, LaserScan, OccupancyGrid, Pose2, pose_xyt};
 use nalgebra::Point2;
 use std::collections::VecDeque;
 
@@ -45,6 +45,11 @@ impl PurePursuit {
     /// True once the last waypoint is reached.
     pub fn is_done(&self) -> bool {
         self.done
+    }
+
+    /// The last waypoint.
+    pub fn goal(&self) -> Option<Point2<f64>> {
+        self.path.last().copied()
     }
 
     /// The carrot: the point one look-ahead ahead along the path.
@@ -122,9 +127,27 @@ pub struct Explorer {
     follower: Option<PurePursuit>,
     since_plan: f64,
     finished: bool,
+    blocked_s: f64,
+    abandoned: Vec<Point2<f64>>,
+}
+
+/// True when a beam of `scan` (taken by a lidar at `mount` on the robot) ends in the corridor the robot is
+/// about to drive through: ahead of the axle by at most `reach`, within `half_width` of its centre line.
+///
+/// The map an explorer plans on holds what was there when it was last updated; this sees what is there now
+/// (the other robot, above all).
+pub fn blocked_ahead(scan: &LaserScan, mount: &Pose2, reach: f64, half_width: f64) -> bool {
+    scan.endpoints(mount).any(|(_, p)| p.x > 0.0 && p.x <= reach && p.y.abs() <= half_width)
 }
 
 impl Explorer {
+    /// How far ahead of the robot's front the way must be clear, metres (less than [`Self::MARGIN`], so that
+    /// walls the planner kept clear of do not stop the robot).
+    pub const STOP_DISTANCE: f64 = 0.15;
+    /// Blocked this long, the robot gives up its goal, seconds.
+    pub const GIVE_UP_S: f64 = 3.0;
+    /// Frontiers this close to an abandoned goal are not chosen again, metres.
+    pub const ABANDONED_RADIUS: f64 = 0.5;
     /// Distance kept from walls beyond the robot's bounding radius, metres: planned paths hug obstacles at
     /// exactly the clearance, and the follower cuts the corners of the grid path.
     pub const MARGIN: f64 = 0.2;
@@ -133,7 +156,16 @@ impl Explorer {
 
     /// An explorer driving at `speed`, keeping `clearance` from walls.
     pub fn new(speed: f64, clearance: f64) -> Self {
-        Explorer { clearance, replan_period: 3.0, speed, follower: None, since_plan: f64::INFINITY, finished: false }
+        Explorer {
+            clearance,
+            replan_period: 3.0,
+            speed,
+            follower: None,
+            since_plan: f64::INFINITY,
+            finished: false,
+            blocked_s: 0.0,
+            abandoned: Vec::new(),
+        }
     }
 
     /// True when no reachable frontier is left.
@@ -150,7 +182,7 @@ impl Explorer {
     /// Plans a path to the nearest frontier on `map` from `pose` (both in the SLAM frame).
     pub fn plan(&mut self, map: &OccupancyGrid, pose: &Pose2) {
         self.since_plan = 0.0;
-        match frontier_path(map, pose, self.clearance) {
+        match frontier_path(map, pose, self.clearance, &self.abandoned, Self::ABANDONED_RADIUS) {
             Some(path) => {
                 let mut f = PurePursuit::new(path, self.speed);
                 f.lookahead = Self::LOOKAHEAD;
@@ -163,13 +195,31 @@ impl Explorer {
         }
     }
 
-    /// Forward speed and turn rate for the robot at `pose` (SLAM frame).
-    pub fn command(&mut self, pose: &Pose2, dt: f64) -> (f64, f64) {
+    /// Forward speed and turn rate for the robot at `pose` (SLAM frame); `blocked` when something is in the
+    /// way right now (see [`blocked_ahead`]).
+    ///
+    /// A blocked robot stops (it may still turn on the spot); blocked for [`Self::GIVE_UP_S`], it abandons its
+    /// goal, as an exploration stack abandons a goal it cannot reach, and plans to another frontier.
+    pub fn command(&mut self, pose: &Pose2, dt: f64, blocked: bool) -> (f64, f64) {
         self.since_plan += dt;
-        match &mut self.follower {
-            Some(f) => f.command(pose, dt),
-            None => (0.0, 0.0),
+        let Some(f) = &mut self.follower else { return (0.0, 0.0) };
+        let (v, w) = f.command(pose, dt);
+        if !(blocked && v > 0.0) {
+            self.blocked_s = 0.0;
+            return (v, w);
         }
+        self.blocked_s += dt;
+        if self.blocked_s >= Self::GIVE_UP_S {
+            self.blocked_s = 0.0;
+            self.abandoned.extend(f.goal());
+            self.follower = None;
+        }
+        (0.0, 0.0)
+    }
+
+    /// Goals given up on so far (SLAM frame): frontiers within [`Self::ABANDONED_RADIUS`] of them are skipped.
+    pub fn abandoned(&self) -> &[Point2<f64>] {
+        &self.abandoned
     }
 }
 
@@ -177,9 +227,16 @@ impl Explorer {
 ///
 /// A frontier cell is a free cell with at least [`FRONTIER_MIN_UNKNOWN`] unknown cells among its eight
 /// neighbours (the edge of unexplored space, not a one-cell hole between two far beams), outside the robot's
-/// own disc. The disc of radius `clearance` around the robot is passable wherever it is not occupied: the
-/// robot stands there, and a lidar does not see the cells under and behind the robot.
-pub fn frontier_path(map: &OccupancyGrid, pose: &Pose2, clearance: f64) -> Option<Vec<Point2<f64>>> {
+/// own disc and farther than `avoid_radius` from every point of `avoid`. The disc of radius `clearance` around
+/// the robot is passable wherever it is not occupied: the robot stands there, and a lidar does not see the
+/// cells under and behind the robot.
+pub fn frontier_path(
+    map: &OccupancyGrid,
+    pose: &Pose2,
+    clearance: f64,
+    avoid: &[Point2<f64>],
+    avoid_radius: f64,
+) -> Option<Vec<Point2<f64>>> {
     let (w, h) = (map.width(), map.height());
     let r = (clearance / map.resolution()).ceil() as i64;
     // Cells too close to a wall are blocked.
@@ -212,7 +269,15 @@ pub fn frontier_path(map: &OccupancyGrid, pose: &Pose2, clearance: f64) -> Optio
             .flat_map(|dy| (-1..=1).map(move |dx| (dx, dy)))
             .filter(|&(dx, dy)| state(cx + dx, cy + dy) == Some(CellState::Unknown))
             .count();
-        if state(cx, cy) == Some(CellState::Free) && unknown_around >= FRONTIER_MIN_UNKNOWN && !on_robot(cx, cy) {
+        let avoided = || {
+            let p = map.cell_center(cx, cy);
+            avoid.iter().any(|q| (p - q).norm() <= avoid_radius)
+        };
+        if state(cx, cy) == Some(CellState::Free)
+            && unknown_around >= FRONTIER_MIN_UNKNOWN
+            && !on_robot(cx, cy)
+            && !avoided()
+        {
             let mut cells = vec![c];
             let mut k = c;
             while parent[k] != k {
@@ -278,13 +343,13 @@ mod tests {
                 g.set(ix, iy, if wall { 2.0 } else { -2.0 });
             }
         }
-        let path = frontier_path(&g, &pose(1.0, 1.0, 0.0), 0.15).expect("a frontier");
+        let path = frontier_path(&g, &pose(1.0, 1.0, 0.0), 0.15, &[], 0.0).expect("a frontier");
         let end = path.last().unwrap();
         assert!(end.x > 3.9 && end.y > 0.7 && end.y < 1.3, "{end:?}");
         for iy in 15..25 {
             g.set(79, iy, 2.0);
         }
-        assert!(frontier_path(&g, &pose(1.0, 1.0, 0.0), 0.15).is_none(), "closed door: nothing to explore");
+        assert!(frontier_path(&g, &pose(1.0, 1.0, 0.0), 0.15, &[], 0.0).is_none(), "closed door: nothing to explore");
     }
 
     #[test]
@@ -303,7 +368,7 @@ mod tests {
                 }
             }
         }
-        let path = frontier_path(&g, &pose(1.05, 1.0, 0.0), 0.3).expect("the unseen space behind the robot");
+        let path = frontier_path(&g, &pose(1.05, 1.0, 0.0), 0.3, &[], 0.0).expect("the unseen space behind the robot");
         let end = path.last().unwrap();
         assert!(end.x < 1.3, "it drives to the edge of the unseen space, not to the hole: {end:?}");
         // Once the space behind is seen, only the hole is left, and a hole is no frontier.
@@ -312,6 +377,65 @@ mod tests {
                 g.set(ix, iy, -2.0);
             }
         }
-        assert!(frontier_path(&g, &pose(1.05, 1.0, 0.0), 0.3).is_none());
+        assert!(frontier_path(&g, &pose(1.05, 1.0, 0.0), 0.3, &[], 0.0).is_none());
+    }
+
+    fn scan_with_one_hit(bearing: f64, range: f32) -> LaserScan {
+        let n = 360;
+        let inc = std::f64::consts::TAU / n as f64;
+        let mut ranges = vec![f32::INFINITY; n];
+        ranges[((bearing + std::f64::consts::PI) / inc).round() as usize % n] = range;
+        LaserScan {
+            stamp: 0.0,
+            angle_min: -std::f64::consts::PI,
+            angle_increment: inc,
+            range_min: 0.1,
+            range_max: 6.0,
+            ranges,
+        }
+    }
+
+    #[test]
+    fn only_what_lies_in_the_way_blocks() {
+        let mount = pose(0.1, 0.0, 0.0);
+        assert!(blocked_ahead(&scan_with_one_hit(0.0, 0.3), &mount, 0.45, 0.25), "0.4 m straight ahead");
+        assert!(!blocked_ahead(&scan_with_one_hit(0.0, 0.5), &mount, 0.45, 0.25), "0.6 m ahead: beyond reach");
+        assert!(!blocked_ahead(&scan_with_one_hit(1.2, 0.5), &mount, 0.45, 0.25), "off to the side");
+        assert!(!blocked_ahead(&scan_with_one_hit(std::f64::consts::PI, 0.2), &mount, 0.45, 0.25), "behind");
+        let mut nothing = scan_with_one_hit(0.0, 0.3);
+        nothing.ranges.fill(f32::INFINITY);
+        assert!(!blocked_ahead(&nothing, &mount, 0.45, 0.25), "max-range readings are no obstacle");
+    }
+
+    #[test]
+    fn a_robot_blocked_for_long_gives_up_its_goal_and_picks_another() {
+        // An open 4 m x 2 m room, known all around the robot, with two unseen alcoves: east and west.
+        let mut g = OccupancyGrid::new(80, 40, 0.05, pose(0.0, 0.0, 0.0)).unwrap();
+        for iy in 0..40 {
+            for ix in 0..80 {
+                let wall = iy == 0 || iy == 39 || ((ix == 0 || ix == 79) && !(15..25).contains(&iy));
+                let unseen = !(3..=76).contains(&ix) && (15..25).contains(&iy);
+                if wall {
+                    g.set(ix, iy, 2.0);
+                } else if !unseen {
+                    g.set(ix, iy, -2.0);
+                }
+            }
+        }
+        let start = pose(2.6, 1.0, 0.0);
+        let mut e = Explorer::new(0.3, 0.2);
+        e.plan(&g, &start);
+        let first = e.follower.as_ref().and_then(PurePursuit::goal).unwrap();
+        assert!(first.x > 3.5, "the nearer, east alcove first: {first:?}");
+        let dt = 0.1;
+        for _ in 0..100 {
+            let (v, _) = e.command(&start, dt, true);
+            assert_eq!(v, 0.0, "a blocked robot does not drive on");
+        }
+        assert_eq!(e.abandoned(), &[first]);
+        assert!(e.wants_plan());
+        e.plan(&g, &start);
+        let second = e.follower.as_ref().and_then(PurePursuit::goal).unwrap();
+        assert!(second.x < 0.5, "then the west one: {second:?}");
     }
 }

@@ -1,6 +1,6 @@
 //! The simulation loop: drive both robots, run their SLAMs, merge their maps, evaluate against truth.
 
-use crate::controller::{Explorer, PurePursuit};
+use crate::controller::{Explorer, PurePursuit, blocked_ahead};
 use crate::eval::{map_acceptance, rmse, transform_error};
 use crate::report::{MergeResult, RobotReport, RunReport};
 use crate::scenario::{ControllerKind, MergeWhen, RobotSetup, Scenario};
@@ -11,7 +11,7 @@ use mrslam_merge::{
     merge,
 };
 use mrslam_sim::geometry::Obstacle;
-use mrslam_sim::{RobotId, Sim, SimConfig, SimError, StepEvents};
+use mrslam_sim::{Footprint, RobotId, Sim, SimConfig, SimError, StepEvents};
 use mrslam_slam::{Rbpf, SlamError};
 use mrslam_viz::{MergeView, RobotInfo, RunRecorder, SlamState};
 use nalgebra::Point2;
@@ -96,6 +96,8 @@ struct Agent<'s> {
     slam: Rbpf,
     pursuit: Option<PurePursuit>,
     explorer: Option<Explorer>,
+    /// The latest scan, for the explorer's look ahead.
+    last_scan: Option<LaserScan>,
     /// (truth, odometry) at each processed scan, in the world and odometry frames.
     processed: Vec<(Pose2, Pose2)>,
     scans: usize,
@@ -129,6 +131,7 @@ impl Agent<'_> {
             if outcome.is_processed() {
                 self.processed.push((true_pose, odom.pose));
             }
+            self.last_scan = Some(scan);
         }
         Ok(())
     }
@@ -184,6 +187,7 @@ pub fn run(scenario: &Scenario, mut opts: RunOptions) -> Result<RunOutput, RunEr
             slam,
             pursuit,
             explorer,
+            last_scan: None,
             processed: Vec::new(),
             scans: 0,
             distance: 0.0,
@@ -229,7 +233,16 @@ pub fn run(scenario: &Scenario, mut opts: RunOptions) -> Result<RunOutput, RunEr
                             a.slam.map().map_err(|error| RunError::Slam { robot: a.setup.name.clone(), error })?;
                         e.plan(&map, &slam_pose);
                     }
-                    e.command(&slam_pose, dt)
+                    let (front, half_width) = match a.setup.model.footprint {
+                        Footprint::Circle { radius } => (radius, radius),
+                        Footprint::Box { length, width } => (0.5 * length, 0.5 * width),
+                    };
+                    let reach = front + Explorer::STOP_DISTANCE;
+                    let blocked = a
+                        .last_scan
+                        .as_ref()
+                        .is_some_and(|scan| blocked_ahead(scan, &a.setup.lidar.mount, reach, half_width + 0.05));
+                    e.command(&slam_pose, dt, blocked)
                 }
                 _ => (0.0, 0.0),
             };
