@@ -9,7 +9,7 @@ use mrslam_merge::{
     Evidence, FusionRule, MapEncoding, MatchParams, MergeParams, MergeReport, Merger, Model, RmapMerger, RmapParams,
     SiftMerger, SiftMergerParams, merge,
 };
-use mrslam_viz::MergeView;
+use mrslam_testbed::runner::merge_view;
 use mrslam_viz::pair::record_pair;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -109,21 +109,7 @@ pub fn run(args: MergeArgs) -> Result<ExitCode> {
     }
     print!("{}", summary(&out.report));
     if let Some(mut rec) = viz.take() {
-        let view = MergeView {
-            algorithm: &out.report.algorithm,
-            host: &name_a,
-            other: &name_b,
-            accepted: out.report.accepted,
-            reason: out.report.reason.as_deref(),
-            matches: out.report.matches,
-            inliers: out.report.inliers,
-            transform: out.report.transform.map(|t| t.to_pose()),
-            error: None,
-            points_a: &out.evidence.points_a,
-            points_b: &out.evidence.points_b,
-            inlier_pairs: &out.evidence.inlier_pairs,
-            merged: out.merged.as_ref(),
-        };
+        let view = merge_view(&out, &name_a, &name_b, None);
         record_pair(&mut rec, &a, &b, &view);
         let stats = rec.finish()?;
         println!("rerun:       {} ({} rows)", args.viz.describe(), stats.rows);

@@ -354,21 +354,7 @@ pub fn run(scenario: &Scenario, mut opts: RunOptions) -> Result<RunOutput, RunEr
             matches: out.report.matches,
         });
         if let Some(v) = opts.viz.as_deref_mut() {
-            v.merge(&MergeView {
-                algorithm: name,
-                host: &host,
-                other: &other,
-                accepted: out.report.accepted,
-                reason: out.report.reason.as_deref(),
-                matches: out.report.matches,
-                inliers: out.report.inliers,
-                transform: out.report.transform.map(|t| t.to_pose()),
-                error: err,
-                points_a: &out.evidence.points_a,
-                points_b: &out.evidence.points_b,
-                inlier_pairs: &out.evidence.inlier_pairs,
-                merged: out.merged.as_ref(),
-            });
+            v.merge(&merge_view(&out, &host, &other, err));
         }
         merges.push(out);
     }
@@ -414,6 +400,31 @@ pub fn write_outputs(out: &RunOutput, dir: &Path) -> Result<(), RunError> {
 }
 
 // ---- rerun hooks: called only when `RunOptions::viz` is set; they hand plain data to mrslam-viz. ----
+
+/// What the rerun recording shows of a merge of `host`'s map (a) and `other`'s (b); `error` against the truth
+/// (rotation radians, translation metres) when known.
+pub fn merge_view<'a>(
+    out: &'a MergeOutcome,
+    host: &'a str,
+    other: &'a str,
+    error: Option<(f64, f64)>,
+) -> MergeView<'a> {
+    MergeView {
+        algorithm: &out.report.algorithm,
+        host,
+        other,
+        accepted: out.report.accepted,
+        reason: out.report.reason.as_deref(),
+        matches: out.report.matches,
+        inliers: out.report.inliers,
+        transform: out.report.transform.map(|t| t.to_pose()),
+        error,
+        points_a: &out.evidence.points_a,
+        points_b: &out.evidence.points_b,
+        inlier_pairs: &out.evidence.inlier_pairs,
+        merged: out.merged.as_ref(),
+    }
+}
 
 /// The world's obstacles as closed outlines (circles as 24-gons).
 fn viz_walls(sim: &Sim) -> Vec<Vec<Point2<f64>>> {
