@@ -11,8 +11,8 @@ fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
 
-const COLUMNS: &str = "trial,overlap_target,overlap,seed,algorithm,accepted,success,false_merge,\
-rotation_error_deg,translation_error_m,time_ms";
+const COLUMNS: &str = "trial,overlap_target,overlap,seed,algorithm,accepted,success,false_merge,rotation_error_deg,\
+translation_error_m,time_ms,rotation_error_at_end_deg,translation_error_at_end_m";
 
 /// A small study: 3 overlaps x 4 trials x (sift, rmap) on 12 m x 10 m floor plans.
 fn small_study(out: &Path, extra: &[&str]) -> Output {
@@ -69,7 +69,8 @@ fn a_small_study_writes_consistent_results_summary_and_plot_and_shards_agree() {
     assert_eq!(header, COLUMNS);
     assert_eq!(rows.len(), 3 * 4 * 2);
     for (i, r) in rows.iter().enumerate() {
-        assert_eq!(r.len(), 11);
+        assert_eq!(r.len(), 13);
+        assert!(r[11].is_empty() && r[12].is_empty(), "a cut pair has no SLAM drift: {r:?}");
         assert_eq!(r[0], (i / 2).to_string(), "sorted by trial");
         assert_eq!(r[4], if i % 2 == 0 { "sift" } else { "rmap" }, "then by algorithm");
         let (accepted, success, false_merge) = (r[5] == "true", r[6] == "true", r[7] == "true");

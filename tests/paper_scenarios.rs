@@ -40,6 +40,15 @@ fn assert_sift_succeeds(r: &RunReport) {
     assert!(m.accepted && m.success, "sift merge did not succeed: {m:?}");
 }
 
+/// The paper's robots end at the common point, where their maps overlap: against the maps' relative pose as
+/// the robots' last poses place them, the SIFT merge is within `rot_deg` and `trans_m` (what it has more
+/// against the start frames is the two SLAM maps' drift along their routes).
+fn assert_sift_tight_at_the_common_point(r: &RunReport, rot_deg: f64, trans_m: f64) {
+    let m = r.merges.iter().find(|m| m.algorithm == "sift").expect("a sift merge ran");
+    let (rot, trans) = (m.rotation_error_at_end_deg.unwrap(), m.translation_error_at_end_m.unwrap());
+    assert!(rot <= rot_deg && trans <= trans_m, "sift merge at the common point: {rot} deg, {trans} m");
+}
+
 /// R-map, honestly: our implementation refuses both paper maps, and nothing wrong gets through.
 ///
 /// What we see: the maximal empty rectangles of a SLAM map depend on every stray hit and every unseen cell,
@@ -66,6 +75,8 @@ fn paper_corridor_maps_well_and_never_merges_wrongly() {
         assert!(robot.map_acceptance > 0.95, "{name}: map acceptance {:.3}", robot.map_acceptance);
     }
     assert_sift_succeeds(&r);
+    // Measured: 0.45 deg, 0.227 m against the start frames; 0.22 deg, 0.118 m at the common point.
+    assert_sift_tight_at_the_common_point(&r, 0.5, 0.15);
     assert_rmap_refuses(&r);
 }
 
@@ -79,8 +90,9 @@ fn paper_two_rooms_maps_well_and_merges() {
         // Measured: 0.974 and 0.936.
         assert!(robot.map_acceptance > 0.9, "{name}: map acceptance {:.3}", robot.map_acceptance);
     }
-    // Measured: 1.6 deg, 0.05 m, 16 inliers of 432 matches.
+    // Measured: 1.6 deg, 0.05 m, 16 inliers of 432 matches; 0.75 deg, 0.031 m at the common point.
     assert_sift_succeeds(&r);
+    assert_sift_tight_at_the_common_point(&r, 1.0, 0.05);
     assert_rmap_refuses(&r);
 }
 

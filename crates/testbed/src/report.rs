@@ -47,6 +47,17 @@ pub struct MergeResult {
     pub rotation_error_deg: Option<f64>,
     /// Translation error against the true relative transform, metres.
     pub translation_error_m: Option<f64>,
+    /// Rotation error, degrees, against the relative transform of the two maps as the robots' last poses place
+    /// them (each map frame put in the world so that its robot's final SLAM pose is the true one).
+    ///
+    /// Where the robots end at a common point, in the overlap of their maps (the paper's scenarios), this
+    /// separates what the merger got wrong from what the two SLAM maps' own drift since their start frames
+    /// adds to `rotation_error_deg`; where they end apart, each map's error at its robot's end counts.
+    #[serde(default)]
+    pub rotation_error_at_end_deg: Option<f64>,
+    /// Translation error against that same transform, metres.
+    #[serde(default)]
+    pub translation_error_at_end_m: Option<f64>,
     /// Acceptance index of the two aligned maps (the algorithm's own verification).
     pub acceptance_index: Option<f64>,
     /// Acceptance index of the merged map against the true map.
@@ -59,6 +70,8 @@ pub struct MergeResult {
     pub transform: Option<TransformXyt>,
     /// True transform (host ← other).
     pub true_transform: TransformXyt,
+    /// The maps' relative transform as the robots' last poses place them (host ← other).
+    pub true_transform_at_end: TransformXyt,
     /// Inliers and matches of the algorithm.
     pub inliers: usize,
     /// Tentative matches.
@@ -118,8 +131,12 @@ impl RunReport {
             );
         }
         for m in &self.merges {
+            let at_end = match (m.rotation_error_at_end_deg, m.translation_error_at_end_m) {
+                (Some(r), Some(t)) => format!(" (at the robots' last poses {r:.2} deg, {t:.3} m)"),
+                _ => String::new(),
+            };
             let err = match (m.rotation_error_deg, m.translation_error_m) {
-                (Some(r), Some(t)) => format!("error {r:.2} deg, {t:.3} m"),
+                (Some(r), Some(t)) => format!("error {r:.2} deg, {t:.3} m{at_end}"),
                 _ => "no transform".to_string(),
             };
             s += &format!(

@@ -287,6 +287,7 @@ pub fn run(scenario: &Scenario, mut opts: RunOptions) -> Result<RunOutput, RunEr
     let mut robots = BTreeMap::new();
     let mut maps = BTreeMap::new();
     let mut frames = BTreeMap::new();
+    let mut end_frames = BTreeMap::new();
     for (k, a) in agents.iter().enumerate() {
         let map = a.slam.map().map_err(|error| RunError::Slam { robot: a.setup.name.clone(), error })?;
         let traj: Vec<Pose2> = a.slam.trajectory().into_iter().map(|(_, p)| p).collect();
@@ -321,12 +322,19 @@ pub fn run(scenario: &Scenario, mut opts: RunOptions) -> Result<RunOutput, RunEr
             v.map(k, &map);
             v.paths(k, &traj);
         }
+        // The map frame placed so that the robot's last SLAM pose is its true pose.
+        let end_frame = match (a.processed.last(), traj.last()) {
+            (Some((t, _)), Some(e)) => t * e.inverse(),
+            _ => t0,
+        };
+        end_frames.insert(a.setup.name.clone(), end_frame);
         frames.insert(a.setup.name.clone(), t0);
         maps.insert(a.setup.name.clone(), map);
     }
     let host = scenario.merge.host.clone();
     let other = scenario.robots.iter().map(|r| r.name.clone()).find(|n| *n != host).expect("two robots");
     let true_t = frames[&host].inv_mul(&frames[&other]);
+    let end_t = end_frames[&host].inv_mul(&end_frames[&other]);
     let algorithms = opts.algorithms.clone().unwrap_or_else(|| scenario.merge.algorithms.clone());
     let mut merges = Vec::new();
     let mut results = Vec::new();
@@ -334,6 +342,7 @@ pub fn run(scenario: &Scenario, mut opts: RunOptions) -> Result<RunOutput, RunEr
         let merger = merger_for(name, scenario)?;
         let out = merge(merger.as_ref(), &maps[&host], &maps[&other], &MergeParams::default());
         let err = out.report.transform.map(|t| transform_error(&t.to_pose(), &true_t));
+        let err_at_end = out.report.transform.map(|t| transform_error(&t.to_pose(), &end_t));
         let success = out.report.accepted
             && err.is_some_and(|(r, t)| {
                 r.to_degrees() <= scenario.success.rotation_deg && t <= scenario.success.translation_m
@@ -344,12 +353,15 @@ pub fn run(scenario: &Scenario, mut opts: RunOptions) -> Result<RunOutput, RunEr
             success,
             rotation_error_deg: err.map(|e| e.0.to_degrees()),
             translation_error_m: err.map(|e| e.1),
+            rotation_error_at_end_deg: err_at_end.map(|e| e.0.to_degrees()),
+            translation_error_at_end_m: err_at_end.map(|e| e.1),
             acceptance_index: out.report.acceptance_index,
             merged_map_acceptance: out.merged.as_ref().map(|m| map_acceptance(&truth, m, &frames[&host])),
             time_ms: out.report.time_ms,
             reason: out.report.reason.clone(),
             transform: out.report.transform,
             true_transform: TransformXyt::from_pose(&true_t),
+            true_transform_at_end: TransformXyt::from_pose(&end_t),
             inliers: out.report.inliers,
             matches: out.report.matches,
         });

@@ -148,6 +148,8 @@ fn run_trial(study: &OverlapStudy, map: &OccupancyGrid, t: &TrialSpec) -> Vec<Tr
                 rotation_error_deg: err.map(|e| e.0.to_degrees()),
                 translation_error_m: err.map(|e| e.1),
                 time_ms: out.report.time_ms,
+                rotation_error_at_end_deg: None,
+                translation_error_at_end_m: None,
             })
         })
         .collect()

@@ -1,9 +1,10 @@
 //! `results.csv`: one row per trial and algorithm; writing, reading, and joining the shards of a study.
 //!
 //! Columns (README, "Studies"): `trial, overlap_target, overlap, seed, algorithm, accepted, success,
-//! false_merge, rotation_error_deg, translation_error_m, time_ms`. Empty cells: `overlap_target` in
-//! simulation-level studies (the overlap is observed, not chosen), the two errors when the algorithm found
-//! no transform. Booleans are `true`/`false`.
+//! false_merge, rotation_error_deg, translation_error_m, time_ms, rotation_error_at_end_deg,
+//! translation_error_at_end_m`. Empty cells: `overlap_target` in simulation-level studies (the overlap is
+//! observed, not chosen), the errors when the algorithm found no transform, the two errors at the end in
+//! map-level studies (a cut pair has no SLAM drift: its truth is exact). Booleans are `true`/`false`.
 
 use super::StudyError;
 use std::collections::BTreeMap;
@@ -12,7 +13,10 @@ use std::path::{Path, PathBuf};
 
 /// The header line of `results.csv`.
 pub const HEADER: &str = "trial,overlap_target,overlap,seed,algorithm,accepted,success,false_merge,\
-rotation_error_deg,translation_error_m,time_ms";
+rotation_error_deg,translation_error_m,time_ms,rotation_error_at_end_deg,translation_error_at_end_m";
+
+/// Number of columns of `results.csv`.
+const COLUMNS: usize = 13;
 
 /// One trial of one algorithm.
 #[derive(Debug, Clone, PartialEq)]
@@ -39,6 +43,11 @@ pub struct TrialRow {
     pub translation_error_m: Option<f64>,
     /// Wall time of the merge, milliseconds.
     pub time_ms: f64,
+    /// Simulation-level studies: rotation error against the maps' relative pose as the robots' last poses
+    /// place them, degrees (see `MergeResult::rotation_error_at_end_deg`).
+    pub rotation_error_at_end_deg: Option<f64>,
+    /// Translation error against that pose, metres.
+    pub translation_error_at_end_m: Option<f64>,
 }
 
 fn opt(v: Option<f64>, digits: usize) -> String {
@@ -49,7 +58,7 @@ impl TrialRow {
     /// The row as a CSV line (no newline). Every column but `time_ms` is a pure function of the trial.
     pub fn to_csv(&self) -> String {
         format!(
-            "{},{},{:.6},{},{},{},{},{},{},{},{:.3}",
+            "{},{},{:.6},{},{},{},{},{},{},{},{:.3},{},{}",
             self.trial,
             self.overlap_target.map_or(String::new(), |v| v.to_string()),
             self.overlap,
@@ -60,15 +69,17 @@ impl TrialRow {
             self.false_merge,
             opt(self.rotation_error_deg, 6),
             opt(self.translation_error_m, 6),
-            self.time_ms
+            self.time_ms,
+            opt(self.rotation_error_at_end_deg, 6),
+            opt(self.translation_error_at_end_m, 6),
         )
     }
 
     /// Parses a CSV line written by [`TrialRow::to_csv`].
     pub fn from_csv(line: &str) -> Result<TrialRow, String> {
         let f: Vec<&str> = line.split(',').map(str::trim).collect();
-        if f.len() != 11 {
-            return Err(format!("expected 11 columns, found {}", f.len()));
+        if f.len() != COLUMNS {
+            return Err(format!("expected {COLUMNS} columns, found {}", f.len()));
         }
         let name = |i: usize| HEADER.split(',').nth(i).unwrap_or("?");
         fn num<T: std::str::FromStr>(f: &[&str], i: usize, name: &dyn Fn(usize) -> &'static str) -> Result<T, String> {
@@ -97,6 +108,8 @@ impl TrialRow {
             rotation_error_deg: opt_num(8)?,
             translation_error_m: opt_num(9)?,
             time_ms: num(&f, 10, &name)?,
+            rotation_error_at_end_deg: opt_num(11)?,
+            translation_error_at_end_m: opt_num(12)?,
         })
     }
 }
@@ -184,6 +197,8 @@ mod tests {
             rotation_error_deg: Some(12.5),
             translation_error_m: None,
             time_ms: 3.25,
+            rotation_error_at_end_deg: None,
+            translation_error_at_end_m: Some(0.125),
         }
     }
 
@@ -191,10 +206,10 @@ mod tests {
     fn rows_round_trip() {
         let r = row(3, "sift");
         let line = r.to_csv();
-        assert_eq!(line, "3,0.05,0.051235,123456789012345,sift,true,false,true,12.500000,,3.250");
+        assert_eq!(line, "3,0.05,0.051235,123456789012345,sift,true,false,true,12.500000,,3.250,,0.125000");
         let back = TrialRow::from_csv(&line).unwrap();
         assert_eq!(back.to_csv(), line);
-        assert!(TrialRow::from_csv("1,2,3").unwrap_err().contains("11 columns"));
+        assert!(TrialRow::from_csv("1,2,3").unwrap_err().contains("13 columns"));
         assert!(TrialRow::from_csv(&line.replace("true,false", "yes,false")).unwrap_err().contains("accepted"));
     }
 

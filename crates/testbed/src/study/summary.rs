@@ -171,6 +171,8 @@ mod tests {
             rotation_error_deg: Some(0.0),
             translation_error_m: Some(0.0),
             time_ms: t,
+            rotation_error_at_end_deg: None,
+            translation_error_at_end_m: None,
         }
     }
 

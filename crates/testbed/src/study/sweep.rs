@@ -21,7 +21,7 @@ use super::shard::Shard;
 use crate::eval::transform_error;
 use crate::runner::{RunOptions, merger_for, run};
 use crate::scenario::Scenario;
-use mrslam_core::pose;
+use mrslam_core::{Pose2, pose};
 use mrslam_merge::{MergeParams, merge};
 use mrslam_sim::World;
 use rayon::prelude::*;
@@ -252,36 +252,44 @@ fn run_trial(sweep: &Sweep, scenario: &Scenario, trial: usize) -> Result<Vec<Tri
     let out = run(scenario, RunOptions { algorithms: Some(by_runner), ..RunOptions::default() })
         .map_err(|e| fail(format!("seed {}: {e}", scenario.seed)))?;
     let report = &out.report;
-    let true_t = report.merges.first().map(|m| m.true_transform.to_pose()).ok_or_else(|| fail("no merge".into()))?;
+    let first = report.merges.first().ok_or_else(|| fail("no merge".into()))?;
+    let (true_t, end_t) = (first.true_transform.to_pose(), first.true_transform_at_end.to_pose());
     let [host, other] = &report.merge_pair;
     let ok = |r: f64, t: f64| r <= scenario.success.rotation_deg && t <= scenario.success.translation_m;
     let mut rows = Vec::new();
     for name in &sweep.algorithms {
-        let row = |accepted: bool, success: bool, err: Option<(f64, f64)>, time_ms: f64| TrialRow {
-            trial,
-            overlap_target: None,
-            overlap: report.observed_overlap,
-            seed: scenario.seed,
-            algorithm: name.clone(),
-            accepted,
-            success,
-            false_merge: accepted && !success,
-            rotation_error_deg: err.map(|e| e.0),
-            translation_error_m: err.map(|e| e.1),
-            time_ms,
-        };
+        let row =
+            |accepted: bool, success: bool, err: Option<(f64, f64)>, at_end: Option<(f64, f64)>, time_ms| TrialRow {
+                trial,
+                overlap_target: None,
+                overlap: report.observed_overlap,
+                seed: scenario.seed,
+                algorithm: name.clone(),
+                accepted,
+                success,
+                false_merge: accepted && !success,
+                rotation_error_deg: err.map(|e| e.0),
+                translation_error_m: err.map(|e| e.1),
+                time_ms,
+                rotation_error_at_end_deg: at_end.map(|e| e.0),
+                translation_error_at_end_m: at_end.map(|e| e.1),
+            };
         if let Some(m) = report.merges.iter().find(|m| &m.algorithm == name) {
             let err = m.rotation_error_deg.zip(m.translation_error_m);
-            rows.push(row(m.accepted, m.success, err, m.time_ms));
+            let at_end = m.rotation_error_at_end_deg.zip(m.translation_error_at_end_m);
+            rows.push(row(m.accepted, m.success, err, at_end, m.time_ms));
         } else {
             let merger = study_merger(name, scenario.seed).ok_or_else(|| fail(format!("unknown algorithm {name}")))?;
             let o = merge(merger.as_ref(), &out.maps[host], &out.maps[other], &MergeParams::default());
-            let err = o.report.transform.map(|x| {
-                let (r, t) = transform_error(&x.to_pose(), &true_t);
-                (r.to_degrees(), t)
-            });
+            let error_to = |truth: &Pose2| {
+                o.report.transform.map(|x| {
+                    let (r, t) = transform_error(&x.to_pose(), truth);
+                    (r.to_degrees(), t)
+                })
+            };
+            let (err, at_end) = (error_to(&true_t), error_to(&end_t));
             let success = o.report.accepted && err.is_some_and(|(r, t)| ok(r, t));
-            rows.push(row(o.report.accepted, success, err, o.report.time_ms));
+            rows.push(row(o.report.accepted, success, err, at_end, o.report.time_ms));
         }
     }
     Ok(rows)
