@@ -144,6 +144,17 @@ fn bad_destinations_fail_before_the_run() {
     assert_eq!(o.status.code(), Some(1), "{e}");
     assert!(e.contains("pip install rerun-sdk==0.36.3"), "{e}");
 
+    // --connect where no viewer listens (a port just freed) fails at once instead of waiting for one.
+    let port = std::net::TcpListener::bind("127.0.0.1:0").unwrap().local_addr().unwrap().port();
+    let addr = format!("127.0.0.1:{port}");
+    let start = std::time::Instant::now();
+    let o = mrslam(&["run", p(&scenario), "--quiet", "--out", p(&out), "--connect", &addr]);
+    let e = text(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{e}");
+    assert!(e.contains(&addr) && e.contains("no rerun viewer answers there"), "{e}");
+    assert!(start.elapsed().as_secs() < 20, "refused only after {:?}", start.elapsed());
+    assert!(!out.join("report.json").exists(), "the run went ahead");
+
     // --connect with something that is no address.
     let o = mrslam(&["run", p(&scenario), "--quiet", "--out", p(&out), "--connect", "no such host at all"]);
     let e = text(&o.stderr);

@@ -19,6 +19,17 @@ pub enum VizError {
          or record to a file with --rrd FILE and open that later"
     )]
     NoViewer,
+    /// `--connect`: nothing answers at the address.
+    #[error(
+        "--connect {addr}: no rerun viewer answers there ({cause}); start one with `rerun`, or use --spawn or \
+         --rrd FILE"
+    )]
+    NoViewerAt {
+        /// The address given.
+        addr: String,
+        /// What the connection attempt said.
+        cause: String,
+    },
     /// The viewer could not be started.
     #[error("--spawn: cannot start the rerun viewer: {0}")]
     Spawn(String),

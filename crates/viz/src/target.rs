@@ -3,7 +3,9 @@
 use crate::error::VizError;
 use rerun::external::re_uri::RedapUri;
 use rerun::sink::{FileSink, FileSinkOptions, GrpcSink, LogSink};
+use std::net::{TcpStream, ToSocketAddrs};
 use std::path::{Path, PathBuf};
+use std::time::Duration;
 
 /// The viewer's default gRPC proxy address.
 pub const DEFAULT_CONNECT: &str = "127.0.0.1:9876";
@@ -52,9 +54,35 @@ impl Target {
                 let info = rerun::spawn(&rerun::SpawnOptions::default()).map_err(|e| VizError::Spawn(e.to_string()))?;
                 grpc(&format!("rerun+http://127.0.0.1:{}/proxy", info.port))
             }
-            Target::Connect(url) => grpc(url),
+            Target::Connect(url) => {
+                // The gRPC sink connects lazily and waits for a viewer without end: find out now.
+                probe(url)?;
+                grpc(url)
+            }
         }
     }
+}
+
+/// How long `--connect` waits for a viewer to answer.
+const PROBE_TIMEOUT: Duration = Duration::from_secs(3);
+
+/// Fails unless something accepts TCP connections at the host and port of `url`.
+fn probe(url: &str) -> Result<(), VizError> {
+    let bad = |why: String| VizError::BadAddress { addr: url.to_string(), why };
+    let authority = url.split("://").nth(1).and_then(|rest| rest.split('/').next()).unwrap_or(url);
+    let addrs: Vec<_> =
+        authority.to_socket_addrs().map_err(|e| bad(format!("cannot resolve {authority}: {e}")))?.collect();
+    let mut last = None;
+    for a in &addrs {
+        match TcpStream::connect_timeout(a, PROBE_TIMEOUT) {
+            Ok(_) => return Ok(()),
+            Err(e) => last = Some(e),
+        }
+    }
+    Err(VizError::NoViewerAt {
+        addr: url.to_string(),
+        cause: last.map_or_else(|| "no address".to_string(), |e| e.to_string()),
+    })
 }
 
 fn open_file(path: &Path) -> Result<Box<dyn LogSink>, VizError> {
