@@ -124,6 +124,30 @@ fn unreadable_map_exits_1_naming_it() {
 }
 
 #[test]
+fn outputs_that_cannot_be_written_fail_before_the_merge() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    write_ros_map(&generate(24, &FloorplanParams::default()), &d.join("a.yaml")).unwrap();
+    let map = d.join("a.yaml");
+    let a = p(&map);
+    let missing = d.join("no/such/folder/m.yaml");
+    for args in [
+        vec!["merge", a, a, "-o", p(&missing)],
+        vec!["merge", a, a, "--report", p(&missing)],
+        vec!["merge", a, a, "--matches-png", p(&missing)],
+    ] {
+        let o = mrslam(&args);
+        let e = text(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "{args:?}: {e}");
+        assert!(e.contains(p(&missing)) && e.contains("does not exist"), "{e}");
+        assert!(!text(&o.stdout).contains("ACCEPTED"), "the merge ran before the output was checked");
+    }
+    let o = mrslam(&["merge", a, a, "-o", p(d)]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(text(&o.stderr).contains("it is a folder"), "{}", text(&o.stderr));
+}
+
+#[test]
 fn rmap_algorithm_writes_the_same_report() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();

@@ -70,6 +70,9 @@ pub struct MergeArgs {
 
 /// Runs `mrslam merge`.
 pub fn run(args: MergeArgs) -> Result<ExitCode> {
+    for p in [&args.output, &args.report, &args.matches_png].into_iter().flatten() {
+        super::check_output(p)?;
+    }
     let a = map_io::read_ros_map(&args.a)?;
     let b = map_io::read_ros_map(&args.b)?;
     let (name_a, name_b) = pair_names(&args.a, &args.b);

@@ -73,6 +73,9 @@ pub struct SlamArgs {
 
 /// Runs `mrslam slam`.
 pub fn run(args: SlamArgs) -> Result<ExitCode> {
+    for p in std::iter::once(&args.output).chain(&args.trajectory) {
+        super::check_output(p)?;
+    }
     let mut params = match args.preset {
         Preset::Gmapping => SlamParams::default(),
         Preset::Hokuyo => SlamParams::hokuyo(),
