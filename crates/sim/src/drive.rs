@@ -29,6 +29,14 @@ impl Footprint {
         }
     }
 
+    /// How far the footprint reaches forward of the axle centre, and to either side of it, metres.
+    pub fn half_extents(&self) -> (f64, f64) {
+        match *self {
+            Footprint::Circle { radius } => (radius, radius),
+            Footprint::Box { length, width } => (0.5 * length, 0.5 * width),
+        }
+    }
+
     /// Outline in the robot frame (counter-clockwise); a circle is approximated by 32 vertices
     /// placed on the circle (inscribed polygon).
     pub fn outline(&self) -> Vec<Point2<f64>> {
@@ -189,6 +197,8 @@ mod tests {
         let (e, p) = (RobotModel::experia(), RobotModel::prawn());
         assert!(e.validate().is_ok() && p.validate().is_ok());
         assert!(e.footprint.bounding_radius() > p.footprint.bounding_radius());
+        assert_eq!(e.footprint.half_extents(), (0.25, 0.21));
+        assert_eq!(p.footprint.half_extents(), (0.15, 0.15));
     }
 
     #[test]

@@ -57,8 +57,14 @@ fn odometry_at(run: &SyntheticRun, traj: &[(f64, Pose2)]) -> Vec<(f64, Pose2)> {
 }
 
 fn office_run(drift: &Drift, seed: u64) -> SyntheticRun {
+    office_run_first(usize::MAX, drift, seed)
+}
+
+/// The Hokuyo office loop's first `poses` poses (all of them for `usize::MAX`).
+fn office_run_first(poses: usize, drift: &Drift, seed: u64) -> SyntheticRun {
     let map = synthetic::office_map();
-    let path = synthetic::waypoint_path(&synthetic::office_loop(), 0.05, 0.1);
+    let path: Vec<Pose2> =
+        synthetic::waypoint_path(&synthetic::office_loop(), 0.05, 0.1).into_iter().take(poses).collect();
     synthetic::simulate(&map, &path, 0.1, &Lidar::hokuyo(), pose(0.1, 0.0, 0.0), drift, seed)
 }
 
@@ -127,10 +133,7 @@ fn rplidar_preset_maps_the_office_too() {
 
 #[test]
 fn same_seed_same_trajectory_bit_for_bit() {
-    let map = synthetic::office_map();
-    let path: Vec<Pose2> =
-        synthetic::waypoint_path(&synthetic::office_loop(), 0.05, 0.1).into_iter().take(300).collect();
-    let run = synthetic::simulate(&map, &path, 0.1, &Lidar::hokuyo(), pose(0.1, 0.0, 0.0), &drifting(), 4);
+    let run = office_run_first(300, &drifting(), 4);
     let key = |f: &Rbpf| -> Vec<(u64, u64, u64, u64)> {
         f.trajectory()
             .iter()
@@ -247,10 +250,7 @@ fn bad_input_is_refused_or_counted() {
 
 #[test]
 fn results_do_not_depend_on_the_number_of_threads() {
-    let map = synthetic::office_map();
-    let path: Vec<Pose2> =
-        synthetic::waypoint_path(&synthetic::office_loop(), 0.05, 0.1).into_iter().take(250).collect();
-    let run = synthetic::simulate(&map, &path, 0.1, &Lidar::hokuyo(), pose(0.1, 0.0, 0.0), &drifting(), 6);
+    let run = office_run_first(250, &drifting(), 6);
     let on = |threads: usize| {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
         // a sharp likelihood, so that resampling (and tile sharing) is part of what is compared
@@ -274,10 +274,7 @@ fn results_do_not_depend_on_the_number_of_threads() {
 fn gmappings_matcher_stays_reachable() {
     // GMapping's defaults with the sensor's range and a short update distance: the kernel-search matcher and
     // hill climbing, GMapping's likelihood; it must still beat the drifting odometry on the first corridor.
-    let map = synthetic::office_map();
-    let path: Vec<Pose2> =
-        synthetic::waypoint_path(&synthetic::office_loop(), 0.05, 0.1).into_iter().take(300).collect();
-    let run = synthetic::simulate(&map, &path, 0.1, &Lidar::hokuyo(), pose(0.1, 0.0, 0.0), &drifting(), 11);
+    let run = office_run_first(300, &drifting(), 11);
     let params = SlamParams {
         max_range: 4.0,
         max_urange: 4.0,

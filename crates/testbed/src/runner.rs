@@ -11,7 +11,7 @@ use mrslam_merge::{
     merge,
 };
 use mrslam_sim::geometry::Obstacle;
-use mrslam_sim::{Footprint, RobotId, Sim, SimConfig, SimError, StepEvents};
+use mrslam_sim::{RobotId, Sim, SimConfig, SimError, StepEvents};
 use mrslam_slam::{Rbpf, SlamError};
 use mrslam_viz::{MergeView, RobotInfo, RunRecorder, SlamState};
 use nalgebra::Point2;
@@ -233,10 +233,7 @@ pub fn run(scenario: &Scenario, mut opts: RunOptions) -> Result<RunOutput, RunEr
                             a.slam.map().map_err(|error| RunError::Slam { robot: a.setup.name.clone(), error })?;
                         e.plan(&map, &slam_pose);
                     }
-                    let (front, half_width) = match a.setup.model.footprint {
-                        Footprint::Circle { radius } => (radius, radius),
-                        Footprint::Box { length, width } => (0.5 * length, 0.5 * width),
-                    };
+                    let (front, half_width) = a.setup.model.footprint.half_extents();
                     let reach = front + Explorer::STOP_DISTANCE;
                     let blocked = a
                         .last_scan
