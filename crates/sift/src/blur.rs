@@ -252,33 +252,38 @@ fn blur_rows_avx512(
 /// the add latency, whatever the width of the active spans.
 const QUAD: usize = 4;
 
-/// Vertical pass of [`CHUNK`] columns at `x` for four output rows (`rows[j]`: the source row offsets of
-/// output row `j`, centre first, then above / below pairs): `k0 c + sum_i k_i (above_i + below_i)`.
+/// Vertical pass of [`CHUNK`] columns at `x` for four consecutive output rows `y .. y + 4`:
+/// `k0 c + sum_i k_i (above_i + below_i)` per row. `t[m]` is the offset of source row `y - r + m`
+/// (reflected), for `m` in `0 .. 2 r + 4`. The rows above and below slide down the window, so each tap
+/// loads two source rows for all four outputs.
 ///
 /// # Safety
-/// Each `rows[j]` holds at least `2 k.len() - 1` offsets, and every offset plus `x + CHUNK` is at most
-/// `src.len()`. (The loop runs once per tap and row: bounds checks there would cost as much as the
-/// arithmetic.)
+/// `t` holds at least `2 k.len() + 2` offsets, and every offset plus `x + CHUNK` is at most `src.len()`.
+/// (The loop runs once per tap: bounds checks there would cost as much as the arithmetic.)
 #[inline(always)]
 #[allow(clippy::needless_range_loop)]
-unsafe fn vquad(src: &[f32], rows: [&[usize]; QUAD], k: &[f32], x: usize) -> [[f32; CHUNK]; QUAD] {
+unsafe fn vquad(src: &[f32], t: &[usize], k: &[f32], x: usize) -> [[f32; CHUNK]; QUAD] {
+    let r = k.len() - 1;
     let p = src.as_ptr();
     // SAFETY (all blocks below): offsets are in bounds by the caller's contract; `CHUNK` f32 values from
     // an in-bounds offset form a valid `[f32; CHUNK]` (f32 has alignment 4, `p` is a slice pointer).
-    let at = |o: usize| unsafe { &*(p.add(o + x) as *const [f32; CHUNK]) };
+    let at = |m: usize| unsafe { *(p.add(*t.get_unchecked(m) + x) as *const [f32; CHUNK]) };
+    // Row j's taps at distance i: `up[j]` is source row y + j - i, `dn[j]` is y + j + i.
+    let mut up: [[f32; CHUNK]; QUAD] = std::array::from_fn(|j| at(r + j));
+    let mut dn = up;
     let mut acc = [[0.0f32; CHUNK]; QUAD];
     for j in 0..QUAD {
-        let c = at(unsafe { *rows[j].get_unchecked(0) });
         for l in 0..CHUNK {
-            acc[j][l] = k[0] * c[l];
+            acc[j][l] = k[0] * up[j][l];
         }
     }
-    for i in 1..k.len() {
+    for i in 1..=r {
+        up = [at(r - i), up[0], up[1], up[2]];
+        dn = [dn[1], dn[2], dn[3], at(r + QUAD - 1 + i)];
         let ki = k[i];
         for j in 0..QUAD {
-            let (a, b) = unsafe { (at(*rows[j].get_unchecked(2 * i - 1)), at(*rows[j].get_unchecked(2 * i))) };
             for l in 0..CHUNK {
-                acc[j][l] += ki * (a[l] + b[l]);
+                acc[j][l] += ki * (up[j][l] + dn[j][l]);
             }
         }
     }
@@ -314,12 +319,42 @@ unsafe fn hquad(bufs: [&[f32]; QUAD], k: &[f32], x: usize) -> [[f32; CHUNK]; QUA
     acc
 }
 
-/// Vertical pass of one column (narrow images).
+/// Outputs of one horizontal block: [`QUAD`] adjacent chunks of one row.
+const BLOCK: usize = QUAD * CHUNK;
+
+/// Horizontal pass of [`BLOCK`] outputs at `x` of one padded row (column `x` at `r + x`): one base
+/// pointer and four independent accumulator chains.
+///
+/// # Safety
+/// `buf` holds at least `x + 2 r + BLOCK` values (`r = k.len() - 1`).
 #[inline(always)]
-fn vpixel(src: &[f32], rows: &[usize], k: &[f32], x: usize) -> f32 {
-    let mut acc = k[0] * src[rows[0] + x];
+#[allow(clippy::needless_range_loop)]
+unsafe fn hblock(buf: &[f32], k: &[f32], x: usize) -> [f32; BLOCK] {
+    let r = k.len() - 1;
+    // SAFETY: offsets up to `x + 2 r` plus `BLOCK` values are in bounds by the caller's contract.
+    let at = |o: usize| unsafe { &*(buf.as_ptr().add(o) as *const [f32; BLOCK]) };
+    let c = at(r + x);
+    let mut acc = [0.0f32; BLOCK];
+    for l in 0..BLOCK {
+        acc[l] = k[0] * c[l];
+    }
+    for i in 1..=r {
+        let ki = k[i];
+        let (a, b) = (at(r + x - i), at(r + x + i));
+        for l in 0..BLOCK {
+            acc[l] += ki * (a[l] + b[l]);
+        }
+    }
+    acc
+}
+
+/// Vertical pass of one column (narrow images) for row `y + j`, `t` as in [`vquad`].
+#[inline(always)]
+fn vpixel(src: &[f32], t: &[usize], j: usize, k: &[f32], x: usize) -> f32 {
+    let r = k.len() - 1;
+    let mut acc = k[0] * src[t[r + j] + x];
     for i in 1..k.len() {
-        acc += k[i] * (src[rows[2 * i - 1] + x] + src[rows[2 * i] + x]);
+        acc += k[i] * (src[t[r + j - i] + x] + src[t[r + j + i] + x]);
     }
     acc
 }
@@ -371,7 +406,8 @@ fn blur_rows_impl<const LANES: usize>(
     let r = k.len() - 1;
     let stride = w + 2 * r;
     let n_rows = out.len() / w;
-    let taps = 2 * r + 1;
+    // Source rows of a quad's vertical windows (see `vquad`).
+    let taps = 2 * r + QUAD;
     let chunks = w.div_ceil(CHUNK);
     let cwpr = chunks.div_ceil(64);
     // The unchecked reads of `vquad` rely on these.
@@ -379,8 +415,8 @@ fn blur_rows_impl<const LANES: usize>(
     if s.vbuf.len() < GROUP * stride {
         s.vbuf.resize(GROUP * stride, 0.0);
     }
-    if s.rows.len() < GROUP * taps {
-        s.rows.resize(GROUP * taps, 0);
+    if s.rows.len() < GROUP.div_ceil(QUAD) * taps {
+        s.rows.resize(GROUP.div_ceil(QUAD) * taps, 0);
     }
     let full: Vec<u64> = (0..cwpr)
         .map(|i| {
@@ -408,16 +444,13 @@ fn blur_rows_impl<const LANES: usize>(
     let mut gy = 0;
     while gy < n_rows {
         let gn = (n_rows - gy).min(GROUP);
-        for j in 0..gn {
-            let y = y0 + gy + j;
-            let t = &mut s.rows[j * taps..(j + 1) * taps];
-            t[0] = y * w;
-            for i in 1..=r {
-                t[2 * i - 1] = reflect101(y as isize - i as isize, h) * w;
-                t[2 * i] = reflect101((y + i) as isize, h) * w;
+        let quads = gn.div_ceil(QUAD);
+        for q in 0..quads {
+            let yq = (y0 + gy + q * QUAD) as isize;
+            for (m, t) in s.rows[q * taps..(q + 1) * taps].iter_mut().enumerate() {
+                *t = reflect101(yq - r as isize + m as isize, h) * w;
             }
         }
-        let quads = gn.div_ceil(QUAD);
         // Vertical pass, strip by strip (the source rows of a strip stay in L1), four rows at a time.
         if w >= CHUNK {
             // The quads' chunk masks, then strips outermost.
@@ -441,19 +474,21 @@ fn blur_rows_impl<const LANES: usize>(
             for cs in (0..chunks).step_by(strip_chunks) {
                 let ce = (cs + strip_chunks).min(chunks);
                 for q in 0..quads {
-                    let qr = quad_rows(q, gn);
-                    let rows = qr.map(|j| &s.rows[j * taps..(j + 1) * taps]);
+                    let t = &s.rows[q * taps..(q + 1) * taps];
+                    let valid = (gn - q * QUAD).min(QUAD);
                     for (a, b, on) in ChunkRuns::new(&u[q * cwpr..(q + 1) * cwpr], ce) {
                         if !on || b <= cs {
                             continue;
                         }
                         for c in a.max(cs)..b {
                             let x = block_x(c, w);
-                            // SAFETY: `rows[j]` has `2 r + 1` offsets, each `row * w` with `row < h`, and
+                            // SAFETY: `t` has `2 r + 4` offsets, each `row * w` with `row < h`, and
                             // `x + CHUNK <= w`, so every read ends within `h * w <= src.len()`.
-                            let acc = unsafe { vquad(src, rows, k, x) };
-                            for (j, v) in qr.iter().zip(&acc) {
-                                s.vbuf[j * stride + r + x..j * stride + r + x + CHUNK].copy_from_slice(v);
+                            let acc = unsafe { vquad(src, t, k, x) };
+                            // A short last quad computed rows past the group: dropped.
+                            for (jq, v) in acc.iter().enumerate().take(valid) {
+                                let o = (q * QUAD + jq) * stride + r + x;
+                                s.vbuf[o..o + CHUNK].copy_from_slice(v);
                             }
                         }
                     }
@@ -461,9 +496,10 @@ fn blur_rows_impl<const LANES: usize>(
             }
         } else {
             for j in 0..gn {
-                let t = &s.rows[j * taps..(j + 1) * taps];
+                let (q, jq) = (j / QUAD, j % QUAD);
+                let t = &s.rows[q * taps..(q + 1) * taps];
                 for x in 0..w {
-                    s.vbuf[j * stride + r + x] = vpixel(src, t, k, x);
+                    s.vbuf[j * stride + r + x] = vpixel(src, t, jq, k, x);
                 }
             }
         }
@@ -487,8 +523,32 @@ fn blur_rows_impl<const LANES: usize>(
                 buf[r + w - 1 + q] = buf[r + reflect101((w - 1 + q) as isize, w)];
             }
         }
-        // Horizontal pass, four rows at a time, then the constant outputs.
-        if w >= CHUNK {
+        // Horizontal pass, a block of four chunks at a time (rows wide enough) or four rows at a time, then
+        // the constant outputs. A block may cover inactive chunks: their windows hold one constant, so they
+        // get the constant's blur, the value the fill below writes too.
+        if w >= BLOCK {
+            for j in 0..gn {
+                let y = y0 + gy + j;
+                let buf = &s.vbuf[j * stride..(j + 1) * stride];
+                let runs: &[u64] = match sparse {
+                    Some(m) => m.out.row(y),
+                    None => &full,
+                };
+                let mut done = 0; // chunks below this one are computed
+                for (a, b, on) in ChunkRuns::new(runs, chunks) {
+                    let mut c = a.max(done);
+                    while on && c < b {
+                        let x = (c * CHUNK).min(w - BLOCK);
+                        // SAFETY: the buffer holds `w + 2 r` values and `x + BLOCK <= w`.
+                        let acc = unsafe { hblock(buf, k, x) };
+                        let o = (gy + j) * w + x;
+                        out[o..o + BLOCK].copy_from_slice(&acc);
+                        c = if x + BLOCK >= w { chunks } else { (x + BLOCK) / CHUNK };
+                        done = c;
+                    }
+                }
+            }
+        } else if w >= CHUNK {
             for q in 0..quads {
                 let qr = quad_rows(q, gn);
                 union(sparse.map(|m| m.out), qr.map(|j| y0 + gy + j), &mut u);
