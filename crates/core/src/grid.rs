@@ -5,6 +5,14 @@ use crate::raycast::CellTraversal;
 use crate::scan::LaserScan;
 use nalgebra::Point2;
 
+/// `x.floor() as i64` (saturating, NaN gives 0), inlined: without SSE4.1, `f64::floor` is a libm call,
+/// and cell lookups do one per coordinate.
+#[inline]
+pub fn floor_i64(x: f64) -> i64 {
+    let t = x as i64;
+    if (t as f64) > x { t.saturating_sub(1) } else { t }
+}
+
 /// Largest grid accepted anywhere (cells): 20 000 × 20 000, i.e. 1 km² at 5 cm, 1.6 GB of f32.
 ///
 /// Inputs that claim more are refused before anything is allocated.
@@ -260,7 +268,7 @@ impl OccupancyGrid {
     #[inline]
     pub fn world_to_cell_i(&self, p: &Point2<f64>) -> (i64, i64) {
         let (x, y) = self.world_to_cell_f(p);
-        (x.floor() as i64, y.floor() as i64)
+        (floor_i64(x), floor_i64(y))
     }
 
     /// The cell a map-frame point falls in, or None off the grid.
@@ -440,6 +448,16 @@ fn check_size(width: usize, height: usize, resolution: f64) -> Result<(), GridEr
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn floor_i64_is_floor_as_i64() {
+        for x in [0.0, -0.0, 0.5, -0.5, 1.0, -1.0, 2.999_999, -2.000_001, 1e300, -1e300, 9.3e18, -9.3e18, f64::NAN] {
+            assert_eq!(floor_i64(x), x.floor() as i64, "{x}");
+        }
+        for x in [f64::INFINITY, f64::NEG_INFINITY, f64::MIN_POSITIVE, -f64::MIN_POSITIVE, 4503599627370495.5] {
+            assert_eq!(floor_i64(x), x.floor() as i64, "{x}");
+        }
+    }
     use crate::pose::pose;
     use proptest::prelude::*;
     use std::f64::consts::PI;

@@ -1,6 +1,7 @@
 //! Fusion: one grid in map a's frame holding both maps (paper Alg. 3, line 8).
 
 use crate::resample::{GridGeometry, covering_geometry, known_corners};
+use mrslam_core::grid::floor_i64;
 use mrslam_core::{CellState, OccupancyGrid, Pose2};
 use nalgebra::Point2;
 
@@ -170,7 +171,7 @@ fn for_each_row_span(
     let exact = |d: f64, want: f64| (d - want).abs() < 1e-9;
     if exact(u.0, 1.0) && exact(u.1, 0.0) && exact(v.0, 0.0) && exact(v.1, 1.0) {
         // Column i of row j shows source cell (floor(a.0) + i, floor(a.1) + j).
-        let (fx, fy) = (a.0.floor() as i64, a.1.floor() as i64);
+        let (fx, fy) = (floor_i64(a.0), floor_i64(a.1));
         for j in 0..th {
             let iy = fy + j as i64;
             if iy < 0 || iy >= src.height() as i64 {

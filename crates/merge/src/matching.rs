@@ -42,19 +42,40 @@ impl Default for MatchParams {
     }
 }
 
-#[inline]
+#[inline(always)]
 fn dist2(a: &[u8], b: &[u8]) -> u32 {
-    // Exact integer distance; the compiler vectorises this fixed-length loop.
-    let mut s = 0u32;
+    // Exact integer distance; the compiler vectorises this fixed-length loop (16-bit differences, their
+    // squares summed pairwise into 32 bits).
+    let (a, b): (&[u8; DESCRIPTOR_LEN], &[u8; DESCRIPTOR_LEN]) =
+        (a.try_into().expect("a descriptor"), b.try_into().expect("a descriptor"));
+    let mut s = 0i32;
     for k in 0..DESCRIPTOR_LEN {
-        let d = a[k] as i32 - b[k] as i32;
-        s += (d * d) as u32;
+        let d = a[k] as i16 - b[k] as i16;
+        s += d as i32 * d as i32;
     }
-    s
+    s as u32
 }
 
 /// Nearest and second-nearest squared distances from `q` to the descriptors of `set`, with the nearest index.
 fn two_nearest(q: &[u8], set: &[u8]) -> (usize, u32, u32) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU supports AVX2 (checked just above).
+            return unsafe { two_nearest_avx2(q, set) };
+        }
+    }
+    two_nearest_impl(q, set)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn two_nearest_avx2(q: &[u8], set: &[u8]) -> (usize, u32, u32) {
+    two_nearest_impl(q, set)
+}
+
+#[inline(always)]
+fn two_nearest_impl(q: &[u8], set: &[u8]) -> (usize, u32, u32) {
     let (mut bi, mut b1, mut b2) = (usize::MAX, u32::MAX, u32::MAX);
     for (i, d) in set.chunks_exact(DESCRIPTOR_LEN).enumerate() {
         let s = dist2(q, d);
@@ -71,6 +92,24 @@ fn two_nearest(q: &[u8], set: &[u8]) -> (usize, u32, u32) {
 
 /// The `k` nearest descriptors of `set` to `q` as (index, squared distance), nearest first.
 fn k_nearest(q: &[u8], set: &[u8], k: usize, out: &mut Vec<(usize, u32)>) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU supports AVX2 (checked just above).
+            return unsafe { k_nearest_avx2(q, set, k, out) };
+        }
+    }
+    k_nearest_impl(q, set, k, out)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn k_nearest_avx2(q: &[u8], set: &[u8], k: usize, out: &mut Vec<(usize, u32)>) {
+    k_nearest_impl(q, set, k, out)
+}
+
+#[inline(always)]
+fn k_nearest_impl(q: &[u8], set: &[u8], k: usize, out: &mut Vec<(usize, u32)>) {
     out.clear();
     for (i, d) in set.chunks_exact(DESCRIPTOR_LEN).enumerate() {
         let s = dist2(q, d);

@@ -6,6 +6,7 @@
 
 use crate::estimate::Model;
 use crate::estimate::fit;
+use mrslam_core::grid::floor_i64;
 use mrslam_core::{CellState, OccupancyGrid, Pose2, pose};
 use nalgebra::Point2;
 
@@ -48,18 +49,27 @@ pub fn refine(a: &OccupancyGrid, walls_b: &[Point2<f64>], t_a_b: &Pose2, p: &Ref
     if !p.enabled {
         return t;
     }
-    // a's walls as a bitmap with a margin of twice the search radius (a point up to r cells outside a,
-    // searched r cells around): no bounds checks or log-odds in the loop.
+    // a's walls as rows of bits with a margin of twice the search radius (a point up to r cells outside a,
+    // searched r cells around): no bounds checks or log-odds in the loop, and a window row is one or two
+    // words whose set bits are visited in column order (the scan order of a plain 2D search).
     let m = 2 * p.radius_cells.max(1);
     let (w, h) = (a.width() as i64 + 2 * m, a.height() as i64 + 2 * m);
-    let mut wall = vec![false; (w * h) as usize];
+    let words = (w as usize).div_ceil(64) + 1; // one spare word: a window read may touch the next one
+    let mut wall = vec![0u64; words * h as usize];
     for iy in 0..a.height() {
         for ix in 0..a.width() {
             if a.state(ix, iy) == CellState::Occupied {
-                wall[((iy as i64 + m) * w + ix as i64 + m) as usize] = true;
+                let (row, col) = ((iy as i64 + m) as usize, (ix as i64 + m) as usize);
+                wall[row * words + col / 64] |= 1 << (col % 64);
             }
         }
     }
+    // Bits `col .. col + len` (len <= 64) of bitmap row `row`, lowest first.
+    let window = |row: usize, col: usize, len: usize| -> u64 {
+        let (i, s) = (row * words + col / 64, col % 64);
+        let v = if s == 0 { wall[i] } else { (wall[i] >> s) | (wall[i + 1] << (64 - s)) };
+        if len >= 64 { v } else { v & ((1u64 << len) - 1) }
+    };
     let stride = if p.max_points == 0 { 1 } else { walls_b.len().div_ceil(p.max_points).max(1) };
     let (mut pa, mut pb) = (Vec::with_capacity(walls_b.len()), Vec::with_capacity(walls_b.len()));
     let mut k = 0;
@@ -69,21 +79,28 @@ pub fn refine(a: &OccupancyGrid, walls_b: &[Point2<f64>], t_a_b: &Pose2, p: &Ref
         pb.clear();
         for q in walls_b.iter().step_by(stride) {
             let (fx, fy) = a.world_to_cell_f(&(t * q));
-            let (cx, cy) = (fx.floor() as i64, fy.floor() as i64);
+            let (cx, cy) = (floor_i64(fx), floor_i64(fy));
             if cx < -r || cy < -r || cx >= a.width() as i64 + r || cy >= a.height() as i64 + r {
                 continue;
             }
             let mut best: Option<(f64, i64, i64)> = None;
             for dy in -r..=r {
-                let row = (cy + dy + m) * w + m;
-                for dx in -r..=r {
-                    if wall[(row + cx + dx) as usize] {
+                let row = (cy + dy + m) as usize;
+                let (mut dx0, mut left) = (-r, (2 * r + 1) as usize);
+                while left > 0 {
+                    let len = left.min(64);
+                    let mut bits = window(row, (cx + dx0 + m) as usize, len);
+                    while bits != 0 {
+                        let dx = dx0 + bits.trailing_zeros() as i64;
+                        bits &= bits - 1;
                         let (ex, ey) = ((cx + dx) as f64 + 0.5 - fx, (cy + dy) as f64 + 0.5 - fy);
                         let d = ex * ex + ey * ey;
                         if best.is_none_or(|b| d < b.0) {
                             best = Some((d, cx + dx, cy + dy));
                         }
                     }
+                    dx0 += len as i64;
+                    left -= len;
                 }
             }
             if let Some((d, x, y)) = best

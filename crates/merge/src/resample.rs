@@ -1,5 +1,6 @@
 //! Resampling a grid into another frame or resolution (nearest neighbour, states kept sharp).
 
+use mrslam_core::grid::floor_i64;
 use mrslam_core::{OccupancyGrid, Pose2, pose};
 use nalgebra::Point2;
 
@@ -44,7 +45,7 @@ pub fn sample_cells(target: &GridGeometry, src: &OccupancyGrid, t_target_src: &P
     for j in 0..target.height {
         let (mut x, mut y) = (ax + j as f64 * dvx, ay + j as f64 * dvy);
         for i in 0..target.width {
-            let (ix, iy) = (x.floor() as i64, y.floor() as i64);
+            let (ix, iy) = (floor_i64(x), floor_i64(y));
             if ix >= 0 && iy >= 0 && ix < sw && iy < sh {
                 f(j * target.width + i, cells[iy as usize * sw as usize + ix as usize]);
             }

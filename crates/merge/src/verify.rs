@@ -127,20 +127,28 @@ struct WallIndex {
 impl WallIndex {
     fn of(a: &OccupancyGrid) -> Self {
         let (w, h) = (a.width(), a.height());
-        let states: Vec<CellState> = a.cells().iter().map(|&l| CellState::from_log_odds(l)).collect();
-        let known = states.iter().map(|&s| s != CellState::Unknown).collect();
+        let cells = a.cells();
+        let known = cells.iter().map(|&l| CellState::from_log_odds(l) != CellState::Unknown).collect();
+        let occupied: Vec<bool> = cells.iter().map(|&l| CellState::from_log_odds(l) == CellState::Occupied).collect();
         // Separable 3x3 dilation of the occupied cells: rows, then columns.
-        let mut rows = vec![false; w * h];
-        for y in 0..h {
-            for x in 0..w {
-                let row = &states[y * w..(y + 1) * w];
-                rows[y * w + x] = row[x.saturating_sub(1)..=(x + 1).min(w - 1)].contains(&CellState::Occupied);
+        let mut rows = occupied.clone();
+        for (o, r) in rows.chunks_exact_mut(w.max(1)).zip(occupied.chunks_exact(w.max(1))) {
+            for (o, &left) in o[1..].iter_mut().zip(r) {
+                *o |= left;
+            }
+            for (o, &right) in o.iter_mut().zip(&r[1..]) {
+                *o |= right;
             }
         }
-        let mut near_wall = vec![false; w * h];
+        let mut near_wall = rows.clone();
         for y in 0..h {
-            for x in 0..w {
-                near_wall[y * w + x] = (y.saturating_sub(1)..=(y + 1).min(h - 1)).any(|yy| rows[yy * w + x]);
+            for yy in [y.wrapping_sub(1), y + 1] {
+                if yy < h {
+                    let (o, r) = (&mut near_wall[y * w..(y + 1) * w], &rows[yy * w..(yy + 1) * w]);
+                    for (o, &v) in o.iter_mut().zip(r) {
+                        *o |= v;
+                    }
+                }
             }
         }
         WallIndex { width: w, height: h, known, near_wall }
