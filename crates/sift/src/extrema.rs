@@ -329,9 +329,12 @@ fn scan_row(
                 let val = v[l];
                 hit[l] = (val.abs() > thr) & (((val > 0.0) & (val >= mx[l])) | ((val < 0.0) & (val <= mn[l])));
             }
-            for (l, &h) in hit.iter().enumerate() {
-                if h {
-                    push(c + l);
+            // Most chunks hold no extremum: one test for all lanes first.
+            if u128::from_ne_bytes(hit.map(u8::from)) != 0 {
+                for (l, &h) in hit.iter().enumerate() {
+                    if h {
+                        push(c + l);
+                    }
                 }
             }
         }
