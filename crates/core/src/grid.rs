@@ -5,6 +5,37 @@ use crate::raycast::CellTraversal;
 use crate::scan::LaserScan;
 use nalgebra::Point2;
 
+/// Cells scanned together when looking for a known one (a vectorised test, then the exact position).
+const SCAN: usize = 16;
+
+#[inline]
+fn is_known(l: f32) -> bool {
+    CellState::from_log_odds(l) != CellState::Unknown
+}
+
+/// Index of the first known cell of a row.
+fn first_known(row: &[f32]) -> Option<usize> {
+    let mut chunks = row.chunks_exact(SCAN);
+    for (k, c) in (&mut chunks).enumerate() {
+        if c.iter().fold(false, |any, &l| any | is_known(l)) {
+            return c.iter().position(|&l| is_known(l)).map(|i| k * SCAN + i);
+        }
+    }
+    let base = row.len() - chunks.remainder().len();
+    chunks.remainder().iter().position(|&l| is_known(l)).map(|i| base + i)
+}
+
+/// Index of the last known cell of a row.
+fn last_known(row: &[f32]) -> Option<usize> {
+    let mut chunks = row.rchunks_exact(SCAN);
+    for (k, c) in (&mut chunks).enumerate() {
+        if c.iter().fold(false, |any, &l| any | is_known(l)) {
+            return c.iter().rposition(|&l| is_known(l)).map(|i| row.len() - (k + 1) * SCAN + i);
+        }
+    }
+    chunks.remainder().iter().rposition(|&l| is_known(l))
+}
+
 /// `x.floor() as i64` (saturating, NaN gives 0), inlined: without SSE4.1, `f64::floor` is a libm call,
 /// and cell lookups do one per coordinate.
 #[inline]
@@ -245,9 +276,8 @@ impl OccupancyGrid {
         let mut b: Option<(usize, usize, usize, usize)> = None;
         for iy in 0..self.height {
             let row = &self.cells[iy * self.width..(iy + 1) * self.width];
-            let first = row.iter().position(|&l| CellState::from_log_odds(l) != CellState::Unknown);
-            if let Some(x0) = first {
-                let x1 = row.iter().rposition(|&l| CellState::from_log_odds(l) != CellState::Unknown).unwrap_or(x0);
+            if let Some(x0) = first_known(row) {
+                let x1 = last_known(row).unwrap_or(x0);
                 b = Some(match b {
                     None => (x0, iy, x1, iy),
                     Some((a, by, c, _)) => (a.min(x0), by, c.max(x1), iy),
@@ -448,6 +478,21 @@ fn check_size(width: usize, height: usize, resolution: f64) -> Result<(), GridEr
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn first_and_last_known_cells_of_rows() {
+        for n in [0usize, 1, 5, 16, 17, 40] {
+            for a in 0..n {
+                for b in a..n {
+                    let mut row = vec![0.0f32; n];
+                    row[a] = 2.0;
+                    row[b] = -2.0;
+                    assert_eq!((first_known(&row), last_known(&row)), (Some(a), Some(b)), "{n} {a} {b}");
+                }
+            }
+            assert_eq!((first_known(&vec![0.1; n]), last_known(&vec![f32::NAN; n])), (None, None));
+        }
+    }
 
     #[test]
     fn floor_i64_is_floor_as_i64() {

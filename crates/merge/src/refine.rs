@@ -49,27 +49,7 @@ pub fn refine(a: &OccupancyGrid, walls_b: &[Point2<f64>], t_a_b: &Pose2, p: &Ref
     if !p.enabled {
         return t;
     }
-    // a's walls as rows of bits with a margin of twice the search radius (a point up to r cells outside a,
-    // searched r cells around): no bounds checks or log-odds in the loop, and a window row is one or two
-    // words whose set bits are visited in column order (the scan order of a plain 2D search).
-    let m = 2 * p.radius_cells.max(1);
-    let (w, h) = (a.width() as i64 + 2 * m, a.height() as i64 + 2 * m);
-    let words = (w as usize).div_ceil(64) + 1; // one spare word: a window read may touch the next one
-    let mut wall = vec![0u64; words * h as usize];
-    for iy in 0..a.height() {
-        for ix in 0..a.width() {
-            if a.state(ix, iy) == CellState::Occupied {
-                let (row, col) = ((iy as i64 + m) as usize, (ix as i64 + m) as usize);
-                wall[row * words + col / 64] |= 1 << (col % 64);
-            }
-        }
-    }
-    // Bits `col .. col + len` (len <= 64) of bitmap row `row`, lowest first.
-    let window = |row: usize, col: usize, len: usize| -> u64 {
-        let (i, s) = (row * words + col / 64, col % 64);
-        let v = if s == 0 { wall[i] } else { (wall[i] >> s) | (wall[i + 1] << (64 - s)) };
-        if len >= 64 { v } else { v & ((1u64 << len) - 1) }
-    };
+    let walls = WallBits::of(a, p.radius_cells.max(1));
     let stride = if p.max_points == 0 { 1 } else { walls_b.len().div_ceil(p.max_points).max(1) };
     let (mut pa, mut pb) = (Vec::with_capacity(walls_b.len()), Vec::with_capacity(walls_b.len()));
     let mut k = 0;
@@ -79,30 +59,7 @@ pub fn refine(a: &OccupancyGrid, walls_b: &[Point2<f64>], t_a_b: &Pose2, p: &Ref
         pb.clear();
         for q in walls_b.iter().step_by(stride) {
             let (fx, fy) = a.world_to_cell_f(&(t * q));
-            let (cx, cy) = (floor_i64(fx), floor_i64(fy));
-            if cx < -r || cy < -r || cx >= a.width() as i64 + r || cy >= a.height() as i64 + r {
-                continue;
-            }
-            let mut best: Option<(f64, i64, i64)> = None;
-            for dy in -r..=r {
-                let row = (cy + dy + m) as usize;
-                let (mut dx0, mut left) = (-r, (2 * r + 1) as usize);
-                while left > 0 {
-                    let len = left.min(64);
-                    let mut bits = window(row, (cx + dx0 + m) as usize, len);
-                    while bits != 0 {
-                        let dx = dx0 + bits.trailing_zeros() as i64;
-                        bits &= bits - 1;
-                        let (ex, ey) = ((cx + dx) as f64 + 0.5 - fx, (cy + dy) as f64 + 0.5 - fy);
-                        let d = ex * ex + ey * ey;
-                        if best.is_none_or(|b| d < b.0) {
-                            best = Some((d, cx + dx, cy + dy));
-                        }
-                    }
-                    dx0 += len as i64;
-                    left -= len;
-                }
-            }
+            let best = walls.nearest(fx, fy, r);
             if let Some((d, x, y)) = best
                 && d <= (r * r) as f64
             {
@@ -129,6 +86,100 @@ pub fn refine(a: &OccupancyGrid, walls_b: &[Point2<f64>], t_a_b: &Pose2, p: &Ref
     t
 }
 
+/// A grid's occupied cells as rows of bits, with a margin of `2 r_max` cells on every side (a point up to
+/// `r` cells outside the grid, searched `r` cells around, stays on the bitmap): no bounds checks or log-odds
+/// in the search.
+struct WallBits {
+    /// Margin, cells.
+    margin: i64,
+    /// Grid size, cells.
+    width: i64,
+    height: i64,
+    /// Words per row (one spare: a window read may touch the next word).
+    words: usize,
+    bits: Vec<u64>,
+}
+
+impl WallBits {
+    fn of(a: &OccupancyGrid, r_max: i64) -> Self {
+        let m = 2 * r_max;
+        let (w, h) = (a.width() as i64, a.height() as i64);
+        let words = ((w + 2 * m) as usize).div_ceil(64) + 1;
+        let mut bits = vec![0u64; words * (h + 2 * m) as usize];
+        for iy in 0..a.height() {
+            for ix in 0..a.width() {
+                if a.state(ix, iy) == CellState::Occupied {
+                    let (row, col) = ((iy as i64 + m) as usize, (ix as i64 + m) as usize);
+                    bits[row * words + col / 64] |= 1 << (col % 64);
+                }
+            }
+        }
+        WallBits { margin: m, width: w, height: h, words, bits }
+    }
+
+    /// Bits `col .. col + len` (`len <= 64`) of bitmap row `row`, lowest first.
+    #[inline]
+    fn window(&self, row: usize, col: usize, len: usize) -> u64 {
+        let (i, s) = (row * self.words + col / 64, col % 64);
+        let v = if s == 0 { self.bits[i] } else { (self.bits[i] >> s) | (self.bits[i + 1] << (64 - s)) };
+        if len >= 64 { v } else { v & ((1u64 << len) - 1) }
+    }
+
+    /// The occupied cell nearest to continuous cell position (`fx`, `fy`) among the `2 r + 1` square cells
+    /// around the one it falls in (`r` at most `r_max`), as (squared distance, ix, iy): the first in row-major
+    /// order among equals, as a plain scan of the square finds it. None when there is none, or the point is
+    /// more than `r` cells off the grid.
+    fn nearest(&self, fx: f64, fy: f64, r: i64) -> Option<(f64, i64, i64)> {
+        let (cx, cy) = (floor_i64(fx), floor_i64(fy));
+        if cx < -r || cy < -r || cx >= self.width + r || cy >= self.height + r {
+            return None;
+        }
+        let m = self.margin;
+        let mut best: Option<(f64, i64, i64)> = None;
+        let mut consider = |dx: i64, dy: i64| {
+            let (ex, ey) = ((cx + dx) as f64 + 0.5 - fx, (cy + dy) as f64 + 0.5 - fy);
+            let d = ex * ex + ey * ey;
+            if best.is_none_or(|b| d < b.0) {
+                best = Some((d, cx + dx, cy + dy));
+            }
+        };
+        for dy in -r..=r {
+            let row = (cy + dy + m) as usize;
+            if 2 * r < 63 {
+                // Within a row, distance grows with the column's distance from the point's column, so only
+                // the nearest wall on either side (and the point's own column) can win: offered in column
+                // order, so ties go to the left as in a full scan.
+                let bits = self.window(row, (cx - r + m) as usize, (2 * r + 1) as usize);
+                let ru = r as u32;
+                let left = bits & ((1u64 << ru) - 1);
+                if left != 0 {
+                    consider(63 - left.leading_zeros() as i64 - r, dy);
+                }
+                if bits >> ru & 1 == 1 {
+                    consider(0, dy);
+                }
+                let right = bits >> (ru + 1);
+                if right != 0 {
+                    consider(1 + right.trailing_zeros() as i64, dy);
+                }
+                continue;
+            }
+            let (mut dx0, mut left) = (-r, (2 * r + 1) as usize);
+            while left > 0 {
+                let len = left.min(64);
+                let mut bits = self.window(row, (cx + dx0 + m) as usize, len);
+                while bits != 0 {
+                    consider(dx0 + bits.trailing_zeros() as i64, dy);
+                    bits &= bits - 1;
+                }
+                dx0 += len as i64;
+                left -= len;
+            }
+        }
+        best
+    }
+}
+
 /// Search radius (cells) of iteration `k`: from `radius_cells` down to one.
 fn radius_at(p: &RefineParams, k: usize) -> i64 {
     (p.radius_cells - (k as i64 * p.radius_cells) / p.iterations.max(1) as i64).max(1)
@@ -138,6 +189,49 @@ fn radius_at(p: &RefineParams, k: usize) -> i64 {
 mod tests {
     use super::*;
     use crate::floorplan::{FloorplanParams, generate};
+
+    #[test]
+    fn nearest_wall_is_the_plain_scan_of_the_square() {
+        let map = generate(9, &FloorplanParams::default());
+        let walls = WallBits::of(&map, 40);
+        let occupied = |x: i64, y: i64| {
+            x >= 0
+                && y >= 0
+                && x < map.width() as i64
+                && y < map.height() as i64
+                && map.state(x as usize, y as usize) == CellState::Occupied
+        };
+        let mut seed = 3u64;
+        let mut rnd = || {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut found = 0;
+        for n in 0..4000 {
+            let r = [1, 2, 4, 31, 32, 40][n % 6];
+            let (fx, fy) = (rnd() * (map.width() + 20) as f64 - 10.0, rnd() * (map.height() + 20) as f64 - 10.0);
+            // Ties: points on cell edges and centres.
+            let (fx, fy) = if n % 5 == 0 { (fx.round(), (fy * 2.0).round() / 2.0) } else { (fx, fy) };
+            let (cx, cy) = (fx.floor() as i64, fy.floor() as i64);
+            let mut want: Option<(f64, i64, i64)> = None;
+            if !(cx < -r || cy < -r || cx >= map.width() as i64 + r || cy >= map.height() as i64 + r) {
+                for y in cy - r..=cy + r {
+                    for x in cx - r..=cx + r {
+                        if occupied(x, y) {
+                            let (ex, ey) = (x as f64 + 0.5 - fx, y as f64 + 0.5 - fy);
+                            let d = ex * ex + ey * ey;
+                            if want.is_none_or(|b| d < b.0) {
+                                want = Some((d, x, y));
+                            }
+                        }
+                    }
+                }
+            }
+            assert_eq!(walls.nearest(fx, fy, r), want, "({fx}, {fy}) r {r}");
+            found += usize::from(want.is_some());
+        }
+        assert!(found > 1000, "{found}");
+    }
 
     #[test]
     fn icp_pulls_a_near_miss_onto_the_walls() {
