@@ -1,10 +1,11 @@
 //! Separable Gaussian blur on contiguous f32 rows, OpenCV's kernel size and `BORDER_REFLECT_101`.
 //!
 //! Each output row is made in two passes over a small row buffer: a vertical pass that accumulates the
-//! kernel's rows (symmetric taps paired, 16 columns at a time in registers), then a horizontal pass over
-//! the padded buffer. The loops are written so the compiler vectorises them; on x86-64 CPUs with AVX2 a
-//! copy compiled for AVX2 is picked at run time. No fused multiply-add is used, so both copies give
-//! bit-identical results.
+//! kernel's rows (symmetric taps paired; four output rows at a time whose windows slide down the source,
+//! 16 columns in registers), then a horizontal pass over the padded buffer (64 columns of a row at a time).
+//! The loops are written so the compiler vectorises them; on x86-64 CPUs with AVX-512 or AVX2 a copy
+//! compiled for it is picked at run time. No fused multiply-add is used, so every copy gives bit-identical
+//! results.
 
 use crate::mask::{CHUNK, ChunkMask, ChunkRuns};
 use rayon::prelude::*;
