@@ -1,5 +1,10 @@
 //! Accuracy and speed harness on the synthetic runs of the crate's tests:
 //! `cargo run --release -p mrslam-slam --example office -- [hokuyo|rplidar|corridor] [name=value ...]`.
+//!
+//! Diagnostics by environment variable: `DRIFT=scale,heading_per_m,sigma_trans,sigma_rot` (odometry model),
+//! `SIMSEED=S` (the Hokuyo data's seed, 11 as in the test), `LIDAR_RANGE`, `LIDAR_FOV`, `LIDAR_NOISE`
+//! (Hokuyo), `TRACE[=N]` (every N-th pose's error), `INCREMENTS` (per-leg increment errors of SLAM and
+//! odometry), `ALL` (every particle's error and log-likelihood).
 
 use mrslam_core::pose::relative;
 use mrslam_core::{CellState, OccupancyGrid, Pose2, pose};
@@ -42,7 +47,12 @@ fn errors(est: &[(f64, Pose2)], truth: &[(f64, Pose2)]) -> (f64, f64) {
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let which = args.first().map(String::as_str).unwrap_or("hokuyo");
-    let drift = Drift { scale: 0.03, heading_per_m: 0.01, sigma_trans: 0.02, sigma_rot: 0.01 };
+    let mut drift = Drift { scale: 0.03, heading_per_m: 0.01, sigma_trans: 0.02, sigma_rot: 0.01 };
+    // DRIFT=scale,heading_per_m,sigma_trans,sigma_rot overrides the odometry error model (diagnostics)
+    if let Ok(v) = std::env::var("DRIFT") {
+        let d: Vec<f64> = v.split(',').map(|x| x.trim().parse().expect("DRIFT=a,b,c,d")).collect();
+        drift = Drift { scale: d[0], heading_per_m: d[1], sigma_trans: d[2], sigma_rot: d[3] };
+    }
     let (run, mut params, seed): (SyntheticRun, SlamParams, u64) = match which {
         "rplidar" => {
             let path = synthetic::waypoint_path(&synthetic::office_loop(), 0.1, 0.2);
@@ -77,7 +87,13 @@ fn main() {
             if let Some(s) = env("LIDAR_NOISE") {
                 lidar.sigma = s;
             }
-            (synthetic::simulate(&m, &path, 0.1, &lidar, pose(0.1, 0.0, 0.0), &drift, 11), SlamParams::hokuyo(), 5)
+            // SIMSEED: the synthetic data's seed (scan noise, odometry noise), 11 as in the test
+            let sim_seed = env("SIMSEED").map_or(11, |s| s as u64);
+            (
+                synthetic::simulate(&m, &path, 0.1, &lidar, pose(0.1, 0.0, 0.0), &drift, sim_seed),
+                SlamParams::hokuyo(),
+                5,
+            )
         }
     };
     let mut seed = seed;
@@ -117,6 +133,47 @@ fn main() {
             println!("{i:4} truth ({tx:5.1},{ty:5.1}) err ({ex:+.3},{ey:+.3},{et:+.4})");
         }
     }
+    if std::env::var("INCREMENTS").is_ok() {
+        // per-update increment errors of the best trajectory and of odometry (robot frame: along-track,
+        // cross-track, heading), summed per leg of the path (legs split where the true heading changes)
+        let traj = f.trajectory();
+        let t_at = |stamp: f64| run.truth[run.truth.binary_search_by(|(s, _)| s.total_cmp(&stamp)).unwrap()].1;
+        let o_at = |stamp: f64| run.odometry.iter().find(|o| o.stamp == stamp).unwrap().pose;
+        let (mut sum_s, mut sum_o, mut n) = ([0.0f64; 3], [0.0f64; 3], 0);
+        let mut leg_start = 0;
+        for k in 1..traj.len() {
+            let (ta, tb) = (t_at(traj[k - 1].0), t_at(traj[k].0));
+            let dt = relative(&ta, &tb);
+            let ds = relative(&traj[k - 1].1, &traj[k].1);
+            let dodo = relative(&o_at(traj[k - 1].0), &o_at(traj[k].0));
+            let es = mrslam_core::pose::pose_xyt(&(dt.inverse() * ds));
+            let eo = mrslam_core::pose::pose_xyt(&(dt.inverse() * dodo));
+            for (acc, e) in [(&mut sum_s, es), (&mut sum_o, eo)] {
+                acc[0] += e.0;
+                acc[1] += e.1;
+                acc[2] += e.2;
+            }
+            n += 1;
+            let turn = mrslam_core::pose::pose_xyt(&dt).2.abs() > 1e-6;
+            let next_turn = k + 1 < traj.len()
+                && mrslam_core::pose::pose_xyt(&relative(&t_at(traj[k].0), &t_at(traj[k + 1].0))).2.abs() > 1e-6;
+            if next_turn != turn || k + 1 == traj.len() {
+                println!(
+                    "updates {leg_start:3}-{k:3} {}: slam sum err ({:+.4},{:+.4},{:+.5}) odo ({:+.4},{:+.4},{:+.5})",
+                    if turn { "turn" } else { "leg " },
+                    sum_s[0],
+                    sum_s[1],
+                    sum_s[2],
+                    sum_o[0],
+                    sum_o[1],
+                    sum_o[2]
+                );
+                let _ = n;
+                (sum_s, sum_o, n) = ([0.0; 3], [0.0; 3], 0);
+                leg_start = k;
+            }
+        }
+    }
     if std::env::var("ALL").is_ok() {
         let ll = f.lineage_log_likelihoods();
         let mut v: Vec<(f64, f64)> =
@@ -124,6 +181,10 @@ fn main() {
         v.sort_by(|a, b| b.1.total_cmp(&a.1));
         let s: Vec<String> = v.iter().map(|(r, l)| format!("{r:.3}@{l:.0}")).collect();
         println!("particles (rms@loglik, best first): {}", s.join(" "));
+    }
+    if f.params().odometry_calibration > 0.0 {
+        let k = f.odometry_calibration();
+        println!("odometry calibration: scale {:+.4} heading {:+.4} rad/m", k[0], k[1]);
     }
     let ai = acceptance(&f.map().unwrap(), &run.truth_map, &run.truth[0].1);
     println!(

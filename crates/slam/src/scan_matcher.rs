@@ -183,6 +183,9 @@ pub struct ScanMatcher {
     /// GMapping matcher: match only the beams that find a cell at the starting pose (see
     /// [`ScanMatcher::beams_in_map`]).
     pub frontier_guard: bool,
+    /// `field` matcher: report the scan's and the prior's information at the matched pose
+    /// ([`MatchResult::information`]; set for [`crate::SlamParams::odometry_calibration`]).
+    pub information: bool,
 }
 
 /// A Gaussian prior on a particle's pose for the `field` matcher: the motion model's spread (standard
@@ -257,6 +260,10 @@ pub struct MatchResult {
     pub likelihood: f64,
     /// Whether the matched pose was accepted (score > minimum score).
     pub accepted: bool,
+    /// `field` matcher with [`ScanMatcher::information`] on: the scan's information about the pose at `pose`
+    /// ([`ScanMatcher::scan_information`]) and the motion prior's (zero without one), map frame, upper
+    /// triangles 00 01 02 11 12 22.
+    pub information: Option<([f64; 6], [f64; 6])>,
 }
 
 /// Result of evaluating a pose: score, log-likelihood and the number of beams that matched.
@@ -313,6 +320,7 @@ impl ScanMatcher {
             motion_prior: params.motion_prior,
             minimum_score: params.minimum_score,
             frontier_guard: params.frontier_guard,
+            information: params.odometry_calibration > 0.0 && params.matcher == MatcherKind::Field,
         }
     }
 
@@ -338,7 +346,7 @@ impl ScanMatcher {
                 let accepted = score > self.minimum_score;
                 let pose = if accepted { corrected } else { *init };
                 let e = self.likelihood_and_score(map, &pose, weigh);
-                MatchResult { pose, score, likelihood: e.likelihood, accepted }
+                MatchResult { pose, score, likelihood: e.likelihood, accepted, information: None }
             }
             MatcherKind::Field => {
                 self.build_field(map, init, scan, &mut scratch.field);
@@ -366,7 +374,10 @@ impl ScanMatcher {
                 let accepted = score > self.minimum_score;
                 let pose = if accepted { best } else { *init };
                 let e = self.field_eval(f, &pose, weigh);
-                MatchResult { pose, score, likelihood: e.likelihood, accepted }
+                let information = self.information.then(|| {
+                    (self.scan_information(f, &pose, &scan.matched), prior.as_ref().map_or([0.0; 6], |p| p.info))
+                });
+                MatchResult { pose, score, likelihood: e.likelihood, accepted, information }
             }
         }
     }
@@ -419,53 +430,9 @@ impl ScanMatcher {
     /// of the beams' distances to their surfels with the score's own weights exp(-d²/sigma), i.e. Newton
     /// steps towards the nearest maximum of the score.
     pub fn refine(&self, f: &Field, p: &Xyt, beams: &[Beam], prior: Option<&PosePrior>) -> Xyt {
-        let (ox, oy) = f.origin();
-        let inv_sigma = 1.0 / self.sigma;
-        // residuals in metres with the kernel's variance sigma/2: weights w·2/sigma in chi-square units
-        let scale = 2.0 * inv_sigma;
         let mut p = *p;
         for _ in 0..self.refine_iterations {
-            let lp = self.laser_pose(&p);
-            let (s, c) = lp.t.sin_cos();
-            let (lx, ly) = (lp.x - ox, lp.y - oy);
-            let (rx, ry) = (p.x - ox, p.y - oy);
-            let mut h = [0.0f64; 6]; // upper triangle of the 3x3 normal matrix: 00 01 02 11 12 22
-            let mut g = [0.0f64; 3];
-            let mut add = |j: [f64; 3], r: f64, w: f64| {
-                let w = w * scale;
-                h[0] += w * j[0] * j[0];
-                h[1] += w * j[0] * j[1];
-                h[2] += w * j[0] * j[2];
-                h[3] += w * j[1] * j[1];
-                h[4] += w * j[1] * j[2];
-                h[5] += w * j[2] * j[2];
-                g[0] += w * j[0] * r;
-                g[1] += w * j[1] * r;
-                g[2] += w * j[2] * r;
-            };
-            for b in beams {
-                let u = lx + c * b.x - s * b.y;
-                let v = ly + s * b.x + c * b.y;
-                let Some((sf, d2)) = f.nearest(u, v, c * b.c - s * b.s, s * b.c + c * b.s) else { continue };
-                let w = exp_neg(d2 * inv_sigma);
-                let (ex, ey) = (u - sf.mx as f64, v - sf.my as f64);
-                // d(end point)/d(theta)
-                let (tx, ty) = (-(v - ry), u - rx);
-                if sf.kind & Surfel::LINE == 0 {
-                    add([1.0, 0.0, tx], ex, w);
-                    add([0.0, 1.0, ty], ey, w);
-                    continue;
-                }
-                let (nx, ny) = sf.normal();
-                let half = f.half(sf);
-                add([nx, ny, nx * tx + ny * ty], nx * ex + ny * ey, w);
-                let along = -ny * ex + nx * ey;
-                let over = along.abs() - half;
-                if over > 0.0 {
-                    let sg = along.signum();
-                    add([-ny * sg, nx * sg, sg * (-ny * tx + nx * ty)], over, w);
-                }
-            }
+            let (mut h, mut g) = self.normal_equations(f, &p, beams);
             if let Some(pr) = prior {
                 let d = pr.delta(&p);
                 let i = &pr.info;
@@ -485,6 +452,64 @@ impl ScanMatcher {
             }
         }
         p
+    }
+
+    /// The scan's information about robot pose `p` on a likelihood field: the Gauss-Newton normal matrix of
+    /// [`ScanMatcher::refine`] without the prior (upper triangle 00 01 02 11 12 22, map frame), i.e. the
+    /// curvature of the negated score in the units of [`PosePrior::info`]. Near zero in a direction the scan
+    /// does not observe.
+    pub fn scan_information(&self, f: &Field, p: &Xyt, beams: &[Beam]) -> [f64; 6] {
+        self.normal_equations(f, p, beams).0
+    }
+
+    /// The normal matrix (upper triangle) and gradient of the beams' weighted squared distances at `p`.
+    fn normal_equations(&self, f: &Field, p: &Xyt, beams: &[Beam]) -> ([f64; 6], [f64; 3]) {
+        let (ox, oy) = f.origin();
+        let inv_sigma = 1.0 / self.sigma;
+        // residuals in metres with the kernel's variance sigma/2: weights w·2/sigma in chi-square units
+        let scale = 2.0 * inv_sigma;
+        let lp = self.laser_pose(p);
+        let (s, c) = lp.t.sin_cos();
+        let (lx, ly) = (lp.x - ox, lp.y - oy);
+        let (rx, ry) = (p.x - ox, p.y - oy);
+        let mut h = [0.0f64; 6]; // upper triangle of the 3x3 normal matrix: 00 01 02 11 12 22
+        let mut g = [0.0f64; 3];
+        let mut add = |j: [f64; 3], r: f64, w: f64| {
+            let w = w * scale;
+            h[0] += w * j[0] * j[0];
+            h[1] += w * j[0] * j[1];
+            h[2] += w * j[0] * j[2];
+            h[3] += w * j[1] * j[1];
+            h[4] += w * j[1] * j[2];
+            h[5] += w * j[2] * j[2];
+            g[0] += w * j[0] * r;
+            g[1] += w * j[1] * r;
+            g[2] += w * j[2] * r;
+        };
+        for b in beams {
+            let u = lx + c * b.x - s * b.y;
+            let v = ly + s * b.x + c * b.y;
+            let Some((sf, d2)) = f.nearest(u, v, c * b.c - s * b.s, s * b.c + c * b.s) else { continue };
+            let w = exp_neg(d2 * inv_sigma);
+            let (ex, ey) = (u - sf.mx as f64, v - sf.my as f64);
+            // d(end point)/d(theta)
+            let (tx, ty) = (-(v - ry), u - rx);
+            if sf.kind & Surfel::LINE == 0 {
+                add([1.0, 0.0, tx], ex, w);
+                add([0.0, 1.0, ty], ey, w);
+                continue;
+            }
+            let (nx, ny) = sf.normal();
+            let half = f.half(sf);
+            add([nx, ny, nx * tx + ny * ty], nx * ex + ny * ey, w);
+            let along = -ny * ex + nx * ey;
+            let over = along.abs() - half;
+            if over > 0.0 {
+                let sg = along.signum();
+                add([-ny * sg, nx * sg, sg * (-ny * tx + nx * ty)], over, w);
+            }
+        }
+        (h, g)
     }
 
     /// The laser's pose in the map frame for robot pose `p`.
@@ -745,6 +770,7 @@ mod tests {
             motion_prior: 0.0,
             minimum_score: 0.0,
             frontier_guard: false,
+            information: false,
         }
     }
 
