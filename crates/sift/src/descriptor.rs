@@ -104,85 +104,63 @@ unsafe fn window_row_avx512(
     k
 }
 
-/// Computes the descriptor at sub-pixel (`px`, `py`) of Gaussian image `img` (`w` x `h`), orientation
-/// `ori` (degrees, gradient convention: `360 - keypoint.angle`) and scale `scl` (octave pixels).
-#[allow(clippy::too_many_arguments)]
-pub fn descriptor(
-    img: &[f32],
-    w: usize,
-    h: usize,
-    px: f32,
-    py: f32,
-    ori: f32,
-    scl: f32,
-    out: &mut [u8],
-    s: &mut DescScratch,
-) {
+/// Where a descriptor is taken: sub-pixel position, orientation and scale in an octave's image.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Frame {
+    /// Column, octave pixels.
+    pub px: f32,
+    /// Row, octave pixels.
+    pub py: f32,
+    /// Orientation in degrees, gradient convention: `360 - keypoint.angle`.
+    pub ori: f32,
+    /// Scale, octave pixels.
+    pub scl: f32,
+}
+
+/// Computes the descriptor of Gaussian image `img` (`w` x `h`) in frame `at`.
+pub fn descriptor(img: &[f32], w: usize, h: usize, at: Frame, out: &mut [u8], s: &mut DescScratch) {
     #[cfg(target_arch = "x86_64")]
     {
         if std::arch::is_x86_feature_detected!("avx512f") {
             // SAFETY: the CPU supports AVX-512F (checked just above).
-            unsafe { descriptor_avx512(img, w, h, px, py, ori, scl, out, s) };
+            unsafe { descriptor_avx512(img, w, h, at, out, s) };
             return;
         }
         if std::arch::is_x86_feature_detected!("avx2") {
             // SAFETY: the CPU supports AVX2 (checked just above).
-            unsafe { descriptor_avx2(img, w, h, px, py, ori, scl, out, s) };
+            unsafe { descriptor_avx2(img, w, h, at, out, s) };
             return;
         }
     }
-    descriptor_impl::<false>(img, w, h, px, py, ori, scl, out, s);
+    descriptor_impl::<false>(img, w, h, at, out, s);
 }
 
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f")]
-#[allow(clippy::too_many_arguments)]
-fn descriptor_avx512(
-    img: &[f32],
-    w: usize,
-    h: usize,
-    px: f32,
-    py: f32,
-    ori: f32,
-    scl: f32,
-    out: &mut [u8],
-    s: &mut DescScratch,
-) {
-    descriptor_impl::<true>(img, w, h, px, py, ori, scl, out, s);
+/// A copy of [`descriptor_impl`] compiled with a target feature (picked at run time by [`descriptor`]).
+macro_rules! descriptor_with_feature {
+    ($name:ident, $feature:literal, $avx512:literal) => {
+        #[cfg(target_arch = "x86_64")]
+        #[target_feature(enable = $feature)]
+        fn $name(img: &[f32], w: usize, h: usize, at: Frame, out: &mut [u8], s: &mut DescScratch) {
+            descriptor_impl::<$avx512>(img, w, h, at, out, s);
+        }
+    };
 }
 
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-#[allow(clippy::too_many_arguments)]
-fn descriptor_avx2(
-    img: &[f32],
-    w: usize,
-    h: usize,
-    px: f32,
-    py: f32,
-    ori: f32,
-    scl: f32,
-    out: &mut [u8],
-    s: &mut DescScratch,
-) {
-    descriptor_impl::<false>(img, w, h, px, py, ori, scl, out, s);
-}
+descriptor_with_feature!(descriptor_avx512, "avx512f", true);
+descriptor_with_feature!(descriptor_avx2, "avx2", false);
 
 /// The descriptor; with `AVX512` (only when the caller has that target feature), the window's samples
 /// are gathered 16 columns at a time (the same values in the same order as the scalar loop).
 #[inline(always)]
-#[allow(clippy::too_many_arguments)]
 fn descriptor_impl<const AVX512: bool>(
     img: &[f32],
     w: usize,
     h: usize,
-    px: f32,
-    py: f32,
-    ori: f32,
-    scl: f32,
+    at: Frame,
     out: &mut [u8],
     s: &mut DescScratch,
 ) {
+    let Frame { px, py, ori, scl } = at;
     let (ptx, pty) = (px.round_ties_even() as isize, py.round_ties_even() as isize);
     let rad = ori * (std::f32::consts::PI / 180.0);
     let (mut sin_t, mut cos_t) = rad.sin_cos();
@@ -391,8 +369,8 @@ mod tests {
             let (px, py) = (rnd() * (w as f32 - 1.0), rnd() * (h as f32 - 1.0));
             let (ori, scl) = (rnd() * 360.0, 0.8 + rnd() * 6.0);
             let (mut fast, mut slow) = ([0u8; DESCRIPTOR_LEN], [0u8; DESCRIPTOR_LEN]);
-            descriptor(&img, w, h, px, py, ori, scl, &mut fast, &mut a);
-            descriptor_impl::<false>(&img, w, h, px, py, ori, scl, &mut slow, &mut b);
+            descriptor(&img, w, h, Frame { px, py, ori, scl }, &mut fast, &mut a);
+            descriptor_impl::<false>(&img, w, h, Frame { px, py, ori, scl }, &mut slow, &mut b);
             assert_eq!(fast, slow, "at ({px}, {py}), angle {ori}, scale {scl}");
         }
     }
@@ -402,16 +380,23 @@ mod tests {
         let (w, h) = (64, 64);
         let img: Vec<f32> = (0..w * h).map(|i| ((i % w) as f32 * 0.3).sin() * 50.0 + (i / w) as f32).collect();
         let mut d = [0u8; DESCRIPTOR_LEN];
-        descriptor(&img, w, h, 32.0, 32.0, 0.0, 3.0, &mut d, &mut DescScratch::default());
+        descriptor(&img, w, h, Frame { px: 32.0, py: 32.0, ori: 0.0, scl: 3.0 }, &mut d, &mut DescScratch::default());
         let n: f32 = d.iter().map(|&v| (v as f32) * (v as f32)).sum::<f32>().sqrt();
         assert!((n - 512.0).abs() < 20.0, "{n}");
         // Transposed image with orientation turned by 90 degrees gives a permuted, similar descriptor.
         let t: Vec<f32> = (0..w * h).map(|i| img[(i % w) * w + i / w]).collect();
         let mut d2 = [0u8; DESCRIPTOR_LEN];
-        descriptor(&t, w, h, 32.0, 32.0, 0.0, 3.0, &mut d2, &mut DescScratch::default());
+        descriptor(&t, w, h, Frame { px: 32.0, py: 32.0, ori: 0.0, scl: 3.0 }, &mut d2, &mut DescScratch::default());
         assert_ne!(d, d2);
         let mut empty = [7u8; DESCRIPTOR_LEN];
-        descriptor(&[1.0; 9], 3, 3, 1.0, 1.0, 0.0, 1.0, &mut empty, &mut DescScratch::default());
+        descriptor(
+            &[1.0; 9],
+            3,
+            3,
+            Frame { px: 1.0, py: 1.0, ori: 0.0, scl: 1.0 },
+            &mut empty,
+            &mut DescScratch::default(),
+        );
         assert!(empty.iter().all(|&v| v == 0));
     }
 }

@@ -262,7 +262,8 @@ fn process_candidate(
             d_angle = 0.0;
         }
         let mut d = [0u8; DESCRIPTOR_LEN];
-        descriptor::descriptor(gauss, w, h, px, py, d_angle, scl_octv, &mut d, desc);
+        let at = descriptor::Frame { px, py, ori: d_angle, scl: scl_octv };
+        descriptor::descriptor(gauss, w, h, at, &mut d, desc);
         out.push((kp, d));
     }
 }
