@@ -57,6 +57,10 @@ pub struct SlamArgs {
     /// Override maxUrange (usable range), metres.
     #[arg(long)]
     pub max_urange: Option<f64>,
+    /// Set any SLAM parameter by its name, as in scenario files (repeatable; applied after the preset and the
+    /// flags above): e.g. `--set odometry_calibration=20 --set srr=0.2`.
+    #[arg(long = "set", value_name = "NAME=VALUE")]
+    pub set: Vec<String>,
     /// Drift injection for testing: systematic heading error, degrees per metre travelled.
     #[arg(long, default_value_t = 0.0)]
     pub drift_heading: f64,
@@ -93,6 +97,13 @@ pub fn run(args: SlamArgs) -> Result<ExitCode> {
     if let Some(v) = args.max_urange {
         params.max_urange = v;
     }
+    for kv in &args.set {
+        let Some((name, value)) = kv.split_once('=') else {
+            bail!("--set {kv}: expected NAME=VALUE");
+        };
+        params.set(name.trim(), value).map_err(|e| anyhow::anyhow!("--set {kv}: {e}"))?;
+    }
+    params.validate().map_err(|e| anyhow::anyhow!("slam parameters: {e}"))?;
     let log = CarmenLog::read(&args.log)?;
     if log.scans.is_empty() {
         bail!("{}: no laser scans in the log", args.log.display());
