@@ -1,4 +1,4 @@
-//! Development aid: the filter on a CARMEN log with any parameters (`mrslam slam` offers presets only);
+//! Development aid: the filter on a CARMEN log with any parameters (as `mrslam slam --set NAME=VALUE`);
 //! writes the best particle's trajectory, `stamp x y theta` per processed scan.
 //! `cargo run --release -p mrslam-slam --example carmen -- LOG OUT.txt [preset=gmapping|hokuyo|rplidar]
 //! [drift=HEADING_DEG_PER_M,SCALE,SIGMA] [name=value ...]`
