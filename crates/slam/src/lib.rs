@@ -14,6 +14,7 @@
 //!
 //! Units are SI; poses are `nalgebra::Isometry2<f64>`; the map frame is the first processed robot pose.
 
+mod calibration;
 pub mod error;
 pub mod field;
 pub mod map_build;

@@ -129,7 +129,7 @@ pub struct SlamParams {
     /// only (it needs the scan's information matrix). Why: the motion prior pulls each match towards the
     /// odometry by the prior's share of the pose's information; where the scan observes a direction only
     /// weakly (along a corridor) a biased odometry's error leaks into every update and accumulates (see
-    /// the `Calibration` notes in `rbpf.rs`). Measured with 20 m: on the synthetic office loop (3 % scale
+    /// the `calibration` module). Measured with 20 m: on the synthetic office loop (3 % scale
     /// error) the Hokuyo preset with 0.1 m updates goes from 0.049 to 0.020 m RMS; in the simulated
     /// corridor, whose odometry has no scale error, it did not help, so no preset turns it on.
     pub odometry_calibration: f64,

@@ -1,5 +1,6 @@
 //! The filter: GMapping's `GridSlamProcessor::processScan` loop over odometry + scans.
 
+use crate::calibration::{CalibrationMatch, OdometryCalibration};
 use crate::error::SlamError;
 use crate::map_build::build_map;
 use crate::motion::MotionModel;
@@ -21,12 +22,6 @@ const MAX_ODOM_COORD: f64 = 1e6;
 const MIN_PRIOR_SIGMA: [f64; 3] = [0.005, 0.005, 0.005];
 /// Most beams accepted in one scan.
 const MAX_BEAMS: usize = 100_000;
-/// `odometry_calibration`: prior standard deviation of each calibration parameter (distance scale error,
-/// heading drift in rad/m) around 0, in the information units of the motion prior (those of the `field`
-/// matcher's score): a few updates' worth of scan data override it.
-const CALIBRATION_PRIOR_SIGMA: f64 = 0.02;
-/// `odometry_calibration`: largest magnitude of each calibration parameter.
-const CALIBRATION_LIMIT: f64 = 0.3;
 
 /// Why a scan was not processed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -154,78 +149,8 @@ pub struct Rbpf {
     /// Variances (robot frame x, y, heading) the motion model added since the last processed scan.
     motion_var: [f64; 3],
     /// Odometry calibration (see [`SlamParams::odometry_calibration`]).
-    calibration: Calibration,
+    calibration: OdometryCalibration,
     counters: Counters,
-}
-
-/// The online odometry calibration of [`SlamParams::odometry_calibration`].
-///
-/// Model: a raw odometry increment (dx, dy, dθ) is corrected to ((1+a)·dx, (1+a)·dy, dθ + b·dx): a distance
-/// scale error a (wheel radii, slip) and a heading drift b per metre driven forward (unequal wheel radii).
-/// (A rotation scale error, a wrong wheel base, is not estimated: on a gently curving route turning and
-/// driving go together and cannot be told apart from b; the scan observes the heading well anyway.)
-///
-/// κ = (a, b) is estimated by an information filter whose measurements are the scan matches. At each update,
-/// particle p's match m (the mode of the scan score plus the motion prior centred on its motion-model sample
-/// s) implies the scan-only optimum z through H_s·(z − s) = (H_s + H_prior)·(m − s), H_s and H_prior being
-/// the scan's and the prior's information at m (from the matcher). z − ĉ, with ĉ the calibrated odometry's
-/// prediction from the particle's previous pose, measures J·(κ_true − κ) with information H_s, where J is the
-/// increment's derivative by κ. A direction the scan does not observe (H_s ≈ 0) teaches nothing, which is
-/// why the residual is not simply m − ĉ: there the prior holds the match at the sample. Particles contribute
-/// by weight; older information fades by exp(−distance / `odometry_calibration`), so that κ can follow a
-/// change of floor.
-#[derive(Debug, Clone, Default)]
-struct Calibration {
-    /// κ = (a, b).
-    kappa: [f64; 2],
-    /// Information about κ from the data (00 01 11), without the prior.
-    info: [f64; 3],
-    /// Raw odometry increments since the last processed scan, composed (robot frame of that scan).
-    raw: Option<Pose2>,
-    /// Calibrated increments since the last processed scan, composed.
-    corrected: Option<Pose2>,
-    /// Σ dx of the raw increments since the last processed scan.
-    forward: f64,
-}
-
-impl Calibration {
-    /// The calibrated increment of a raw one.
-    fn correct(&self, dx: f64, dy: f64, dt: f64) -> (f64, f64, f64) {
-        let [a, b] = self.kappa;
-        ((1.0 + a) * dx, (1.0 + a) * dy, dt + b * dx)
-    }
-
-    /// Records a raw increment and its calibrated version.
-    fn record(&mut self, raw: (f64, f64, f64), corrected: (f64, f64, f64)) {
-        let compose =
-            |acc: Option<Pose2>, (x, y, t): (f64, f64, f64)| Some(acc.unwrap_or_else(Pose2::identity) * pose(x, y, t));
-        self.raw = compose(self.raw, raw);
-        self.corrected = compose(self.corrected, corrected);
-        self.forward += raw.0;
-    }
-
-    /// Forgets the increments (after a processed scan).
-    fn reset_increments(&mut self) {
-        self.raw = None;
-        self.corrected = None;
-        self.forward = 0.0;
-    }
-}
-
-/// Adds the upper-triangle 3x3 symmetric matrix `m` times `w` to `acc`.
-fn add_sym(acc: &mut [f64; 6], m: &[f64; 6], w: f64) {
-    for k in 0..6 {
-        acc[k] += w * m[k];
-    }
-}
-
-/// The symmetric 3x3 matrix (upper triangle) times vector `v`.
-fn sym_mul(m: &[f64; 6], v: &[f64; 3]) -> [f64; 3] {
-    [
-        m[0] * v[0] + m[1] * v[1] + m[2] * v[2],
-        m[1] * v[0] + m[3] * v[1] + m[4] * v[2],
-        m[2] * v[0] + m[4] * v[1] + m[5] * v[2],
-    ]
 }
 
 fn to_xyt(p: &Pose2) -> Xyt {
@@ -265,7 +190,7 @@ impl Rbpf {
             linear_distance: 0.0,
             angular_distance: 0.0,
             motion_var: [0.0; 3],
-            calibration: Calibration::default(),
+            calibration: OdometryCalibration::default(),
             counters: Counters::default(),
         })
     }
@@ -510,59 +435,32 @@ impl Rbpf {
         }))
     }
 
-    /// One step of the odometry calibration's information filter (see [`Calibration`]) from the matches of
-    /// this update: `starts` are the particles' motion-model samples, `information` the matcher's scan and
-    /// prior information at each match. Runs once the update's weights are known, before resampling and
-    /// mapping (the particles' trajectory nodes still end at the previous update).
+    /// One step of the odometry calibration (see [`OdometryCalibration`]) from the matches of this update:
+    /// `starts` are the particles' motion-model samples, `information` the matcher's scan and prior
+    /// information at each match. Runs once the update's weights are known, before resampling and mapping
+    /// (the particles' trajectory nodes still end at the previous update).
     fn calibrate(&mut self, starts: &[Xyt], information: &[Option<([f64; 6], [f64; 6])>]) {
-        let cal = &self.calibration;
-        let (Some(raw), Some(corrected)) = (cal.raw, cal.corrected) else { return };
-        let (rx, ry, _) = pose_xyt(&raw);
-        let forward = cal.forward;
-        let dot = |u: &[f64; 3], v: &[f64; 3]| u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
-        let diff = |p: &Xyt, q: &Xyt| [p.x - q.x, p.y - q.y, mrslam_core::pose::normalize_angle(p.t - q.t)];
-        let (mut a, mut g) = ([0.0f64; 3], [0.0f64; 2]);
-        for (((part, start), info), &w) in self.particles.iter().zip(starts).zip(information).zip(&self.weights) {
-            let (Some((hs, hp)), Some(prev)) = (info, part.node.as_ref()) else { continue };
-            let prev = prev.pose;
-            // the calibrated odometry's prediction from the previous pose
-            let c = to_xyt(&(to_pose(&prev) * corrected));
-            // H_s (z - c) = (H_s + H_prior) (m - s) + H_s (s - c)
-            let mut ht = *hs;
-            add_sym(&mut ht, hp, 1.0);
-            let (r1, r2) = (sym_mul(&ht, &diff(&part.pose, start)), sym_mul(hs, &diff(start, &c)));
-            let r = [r1[0] + r2[0], r1[1] + r2[1], r1[2] + r2[2]];
-            // J's columns, d(increment)/d(a, b), in the map frame
-            let (s, co) = prev.t.sin_cos();
-            let cols = [[co * rx - s * ry, s * rx + co * ry, 0.0], [0.0, 0.0, forward]];
-            let hcols = [sym_mul(hs, &cols[0]), sym_mul(hs, &cols[1])];
-            a[0] += w * dot(&cols[0], &hcols[0]);
-            a[1] += w * dot(&cols[0], &hcols[1]);
-            a[2] += w * dot(&cols[1], &hcols[1]);
-            g[0] += w * dot(&cols[0], &r);
-            g[1] += w * dot(&cols[1], &r);
-        }
-        let cal = &mut self.calibration;
-        let fade = (-forward.abs() / self.params.odometry_calibration).exp();
-        for (i, ak) in cal.info.iter_mut().zip(a) {
-            *i = fade * *i + ak;
-        }
-        let p0 = 1.0 / (CALIBRATION_PRIOR_SIGMA * CALIBRATION_PRIOR_SIGMA);
-        let (h00, h01, h11) = (cal.info[0] + p0, cal.info[1], cal.info[2] + p0);
-        let det = h00 * h11 - h01 * h01;
-        if det.is_finite() && det > 0.0 {
-            let step = [(h11 * g[0] - h01 * g[1]) / det, (h00 * g[1] - h01 * g[0]) / det];
-            for (k, s) in cal.kappa.iter_mut().zip(step) {
-                *k = (*k + s).clamp(-CALIBRATION_LIMIT, CALIBRATION_LIMIT);
-            }
-        }
+        let matches = self.particles.iter().zip(starts).zip(information).zip(&self.weights).filter_map(
+            |(((part, start), info), &weight)| {
+                let (Some((scan, prior)), Some(node)) = (info, part.node.as_ref()) else { return None };
+                Some(CalibrationMatch {
+                    matched: part.pose,
+                    start: *start,
+                    previous: node.pose,
+                    scan: *scan,
+                    prior: *prior,
+                    weight,
+                })
+            },
+        );
+        self.calibration.update(matches, self.params.odometry_calibration);
     }
 
     /// The odometry calibration's current estimate: distance scale error a and heading drift b (rad per metre
     /// driven) by which raw increments (dx, dy, dθ) are corrected to ((1+a)·dx, (1+a)·dy, dθ + b·dx); zeros
     /// when `odometry_calibration` is off.
     pub fn odometry_calibration(&self) -> [f64; 2] {
-        self.calibration.kappa
+        self.calibration.kappa()
     }
 
     /// Index of the best particle: the highest lineage log-likelihood (GMapping's `weightSum`), lowest index
