@@ -2,8 +2,9 @@
 //! `cargo run --release -p mrslam-slam --example office -- [hokuyo|rplidar|corridor] [name=value ...]`.
 //!
 //! Diagnostics by environment variable: `DRIFT=scale,heading_per_m,sigma_trans,sigma_rot` (odometry model),
-//! `SIMSEED=S` (the Hokuyo data's seed, 11 as in the test), `LIDAR_RANGE`, `LIDAR_FOV`, `LIDAR_NOISE`
-//! (Hokuyo), `TRACE[=N]` (every N-th pose's error), `INCREMENTS` (per-leg increment errors of SLAM and
+//! `SIMSEED=S` (the Hokuyo data's seed, 11 as in the test), `SIMLIKE` (the simulator's lidar noise and
+//! mount), `LIDAR_RANGE`, `LIDAR_FOV`, `LIDAR_NOISE`,
+//! `LIDAR_NOISE_PER_M`, `LIDAR_DROPOUT` (Hokuyo), `TRACE[=N]` (every N-th pose's error), `INCREMENTS` (per-leg increment errors of SLAM and
 //! odometry), `ALL` (every particle's error and log-likelihood).
 
 use mrslam_core::pose::relative;
@@ -76,7 +77,10 @@ fn main() {
             let path = synthetic::waypoint_path(&synthetic::office_loop(), 0.05, 0.1);
             let m = synthetic::office_map();
             let env = |k: &str| std::env::var(k).ok().and_then(|v| v.parse::<f64>().ok());
-            let mut lidar = Lidar::hokuyo();
+            // SIMLIKE: the simulator's noise model and mount (0.15 m ahead instead of the test's 0.1 m)
+            let simlike = std::env::var("SIMLIKE").is_ok();
+            let mut lidar = if simlike { Lidar::hokuyo_as_simulated() } else { Lidar::hokuyo() };
+            let mount = pose(if simlike { 0.15 } else { 0.1 }, 0.0, 0.0);
             if let Some(r) = env("LIDAR_RANGE") {
                 lidar.range_max = r as f32;
             }
@@ -87,13 +91,15 @@ fn main() {
             if let Some(s) = env("LIDAR_NOISE") {
                 lidar.sigma = s;
             }
+            if let Some(s) = env("LIDAR_NOISE_PER_M") {
+                lidar.sigma_per_m = s;
+            }
+            if let Some(p) = env("LIDAR_DROPOUT") {
+                lidar.dropout = p;
+            }
             // SIMSEED: the synthetic data's seed (scan noise, odometry noise), 11 as in the test
             let sim_seed = env("SIMSEED").map_or(11, |s| s as u64);
-            (
-                synthetic::simulate(&m, &path, 0.1, &lidar, pose(0.1, 0.0, 0.0), &drift, sim_seed),
-                SlamParams::hokuyo(),
-                5,
-            )
+            (synthetic::simulate(&m, &path, 0.1, &lidar, mount, &drift, sim_seed), SlamParams::hokuyo(), 5)
         }
     };
     let mut seed = seed;

@@ -26,19 +26,45 @@ pub struct Lidar {
     pub range_min: f32,
     /// Longest range, metres.
     pub range_max: f32,
-    /// Range noise standard deviation, metres.
+    /// Range noise standard deviation, metres (the constant part).
     pub sigma: f64,
+    /// Range noise growing with the range: standard deviation `sigma + sigma_per_m * range`.
+    pub sigma_per_m: f64,
+    /// Probability that a beam returns no echo (read as NaN, as the simulator's lidar reports it).
+    pub dropout: f64,
 }
 
 impl Lidar {
     /// Hokuyo URG-04LX class: 240°, 667 beams (0.36°), 4 m, 1 cm noise.
     pub fn hokuyo() -> Self {
-        Lidar { fov: 240f64.to_radians(), beams: 667, range_min: 0.06, range_max: 4.0, sigma: 0.01 }
+        Lidar {
+            fov: 240f64.to_radians(),
+            beams: 667,
+            range_min: 0.06,
+            range_max: 4.0,
+            sigma: 0.01,
+            sigma_per_m: 0.0,
+            dropout: 0.0,
+        }
+    }
+
+    /// [`Lidar::hokuyo`] with the simulator's noise model (`mrslam-sim`'s `hokuyo_urg_04lx`): 1 cm + 0.5 % of
+    /// the range, 0.2 % dropouts. (Its mount, 0.15 m ahead, is the run's laser offset.)
+    pub fn hokuyo_as_simulated() -> Self {
+        Lidar { sigma_per_m: 0.005, dropout: 0.002, ..Self::hokuyo() }
     }
 
     /// RpLidar A1 class: 360°, 360 beams, 6 m, 1 cm noise.
     pub fn rplidar() -> Self {
-        Lidar { fov: 2.0 * std::f64::consts::PI, beams: 360, range_min: 0.2, range_max: 6.0, sigma: 0.01 }
+        Lidar {
+            fov: 2.0 * std::f64::consts::PI,
+            beams: 360,
+            range_min: 0.2,
+            range_max: 6.0,
+            sigma: 0.01,
+            sigma_per_m: 0.0,
+            dropout: 0.0,
+        }
     }
 
     /// Angle between beams.
@@ -50,7 +76,7 @@ impl Lidar {
         }
     }
 
-    /// A scan from `sensor` (map frame) on `map`, with Gaussian range noise from `rng`.
+    /// A scan from `sensor` (map frame) on `map`, with Gaussian range noise (and dropouts) from `rng`.
     pub fn scan<R: Rng>(&self, map: &OccupancyGrid, sensor: &Pose2, stamp: f64, rng: &mut R) -> LaserScan {
         let (x, y, t) = pose_xyt(sensor);
         let inc = self.increment();
@@ -59,10 +85,14 @@ impl Lidar {
         let ranges = (0..self.beams)
             .map(|i| {
                 let a = t + angle_min + i as f64 * inc;
+                // Drawn only when dropouts are modelled, so runs without them keep their noise sequence.
+                if self.dropout > 0.0 && rng.random::<f64>() < self.dropout {
+                    return f32::NAN;
+                }
                 match map.cast_ray(&from, a, self.range_max as f64) {
                     Some(r) => {
                         let z: f64 = rng.sample(StandardNormal);
-                        let r = (r + z * self.sigma).max(0.0) as f32;
+                        let r = (r + z * (self.sigma + self.sigma_per_m * r)).max(0.0) as f32;
                         if r >= self.range_max { self.range_max } else { r }
                     }
                     None => self.range_max,
@@ -329,5 +359,36 @@ mod tests {
             let c = g.world_to_cell(&Point2::new(p.translation.x, p.translation.y)).unwrap();
             assert!(g.get(c.0, c.1) < 0.0, "the path stays in free space");
         }
+    }
+
+    #[test]
+    fn simulated_noise_grows_with_range_and_drops_beams() {
+        let g = office_map();
+        let at = pose(2.0, 2.0, 0.3);
+        let clean = Lidar { sigma: 0.0, ..Lidar::hokuyo() }.scan(&g, &at, 0.0, &mut ChaCha8Rng::seed_from_u64(1));
+        let noisy = Lidar { dropout: 0.1, ..Lidar::hokuyo_as_simulated() };
+        // (near, far) sums of squared errors and counts, and the dropouts.
+        let (mut near, mut far, mut dropped, mut beams) = ((0.0, 0usize), (0.0, 0usize), 0usize, 0usize);
+        let mut rng = ChaCha8Rng::seed_from_u64(2);
+        for _ in 0..40 {
+            let s = noisy.scan(&g, &at, 0.0, &mut rng);
+            for (r, c) in s.ranges.iter().zip(&clean.ranges) {
+                beams += 1;
+                if r.is_nan() {
+                    dropped += 1;
+                } else if *c < 3.9 {
+                    let e = ((r - c) as f64).powi(2);
+                    let bin = if *c < 2.5 { &mut near } else { &mut far };
+                    bin.0 += e;
+                    bin.1 += 1;
+                }
+            }
+        }
+        let rate = dropped as f64 / beams as f64;
+        assert!((rate - 0.1).abs() < 0.01, "dropout rate {rate}");
+        let (sn, sf) = ((near.0 / near.1 as f64).sqrt(), (far.0 / far.1 as f64).sqrt());
+        assert!(near.1 > 1000 && far.1 > 1000, "{near:?} {far:?}");
+        // 1 cm + 0.5 % of the range: about 2 cm near (< 2.5 m), more far.
+        assert!(sn > 0.018 && sn < 0.0225 && sf > sn * 1.1 && sf < 0.03, "near {sn}, far {sf}");
     }
 }
