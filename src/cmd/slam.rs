@@ -182,6 +182,14 @@ pub fn run(args: SlamArgs) -> Result<ExitCode> {
         filter.neff(),
         filter.params().particles
     );
+    if filter.params().odometry_calibration > 0.0 {
+        let [scale, heading] = filter.odometry_calibration();
+        println!(
+            "odometry calibration learnt: distance scale {:+.2} %, heading drift {:+.4} rad/m",
+            100.0 * scale,
+            heading
+        );
+    }
     println!(
         "map {} ({}x{} cells at {} m: {free} free, {occ} occupied, {unknown} unknown)",
         args.output.display(),
