@@ -216,6 +216,8 @@ fn for_each_row_span(
 mod tests {
     use super::*;
     use mrslam_core::pose;
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
 
     #[test]
     fn fused_grid_covers_both_and_combines() {
@@ -269,11 +271,8 @@ mod tests {
 
     #[test]
     fn row_spans_match_the_straightforward_fusion() {
-        let mut seed = 11u64;
-        let mut rnd = || {
-            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = ChaCha8Rng::seed_from_u64(11);
+        let mut rnd = || rng.random::<f64>();
         for case in 0..24 {
             let (wa, ha, wb, hb) = (30 + case * 3, 25 + case * 2, 41 - case, 33 + case % 5);
             let yaw_a = if case % 5 == 0 { 0.3 } else { 0.0 };

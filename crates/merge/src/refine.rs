@@ -189,6 +189,8 @@ fn radius_at(p: &RefineParams, k: usize) -> i64 {
 mod tests {
     use super::*;
     use crate::floorplan::{FloorplanParams, generate};
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
 
     #[test]
     fn nearest_wall_is_the_plain_scan_of_the_square() {
@@ -201,11 +203,8 @@ mod tests {
                 && y < map.height() as i64
                 && map.state(x as usize, y as usize) == CellState::Occupied
         };
-        let mut seed = 3u64;
-        let mut rnd = || {
-            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = ChaCha8Rng::seed_from_u64(3);
+        let mut rnd = || rng.random::<f64>();
         let mut found = 0;
         for n in 0..4000 {
             let r = [1, 2, 4, 31, 32, 40][n % 6];

@@ -346,11 +346,8 @@ mod tests {
     fn vector_paths_match_the_scalar_loop_bit_for_bit() {
         // On a CPU with AVX-512 (or AVX2) `descriptor` takes that path; the scalar form is the reference.
         let (w, h) = (97, 83);
-        let mut seed = 11u64;
-        let mut rnd = || {
-            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            (seed >> 40) as f32 / (1u64 << 24) as f32
-        };
+        let mut lcg = crate::synth::Lcg(11);
+        let mut rnd = || lcg.f32();
         // Flat areas (zero gradients) with steps and a smooth part, like a blurred map.
         let img: Vec<f32> = (0..w * h)
             .map(|i| {

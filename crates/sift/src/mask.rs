@@ -592,11 +592,8 @@ mod tests {
 
     #[test]
     fn dilations_match_naive() {
-        let mut seed = 12345u64;
-        let mut rnd = || {
-            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            (seed >> 33) as usize
-        };
+        let mut lcg = crate::synth::Lcg(12345);
+        let mut rnd = || (lcg.next_u32() >> 1) as usize;
         for &(w, h) in &[(1usize, 1usize), (5, 3), (64, 7), (65, 20), (130, 41), (200, 3), (3, 90)] {
             for &r in &[0usize, 1, 2, 5, 13, 63, 64, 70] {
                 let mut m = BitMask::default();

@@ -4,8 +4,7 @@
 
 use crate::{Features, GrayImage, Sift, SiftParams};
 
-#[path = "../tests/common/synth.rs"]
-mod synth;
+use crate::synth;
 
 /// Panics with the first difference between two feature sets.
 fn assert_identical(sparse: &Features, dense: &Features, what: &str) {
