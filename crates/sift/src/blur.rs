@@ -10,11 +10,6 @@
 use crate::mask::{CHUNK, ChunkMask, ChunkRuns};
 use rayon::prelude::*;
 
-/// Columns processed together in registers (enough independent accumulators to hide add latency).
-const LANES_AVX512: usize = 64;
-/// Same for AVX2 and the portable path.
-const LANES: usize = 32;
-
 /// A symmetric Gaussian kernel: `half[0]` is the centre weight, `half[i]` the weight at offsets ±i.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Kernel {
@@ -214,40 +209,32 @@ fn blur_rows(
             return;
         }
     }
-    blur_rows_impl::<LANES>(src, out, w, h, y0, kernel, s, sparse);
+    blur_rows_impl(src, out, w, h, y0, kernel, s, sparse);
 }
 
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-#[allow(clippy::too_many_arguments)]
-fn blur_rows_avx2(
-    src: &[f32],
-    out: &mut [f32],
-    w: usize,
-    h: usize,
-    y0: usize,
-    kernel: &Kernel,
-    s: &mut BlurScratch,
-    sparse: Option<Sparse<'_>>,
-) {
-    blur_rows_impl::<LANES>(src, out, w, h, y0, kernel, s, sparse);
+/// A copy of `blur_rows_impl` compiled with a target feature (picked at run time by `blur_rows`).
+macro_rules! blur_rows_with_feature {
+    ($name:ident, $feature:literal) => {
+        #[cfg(target_arch = "x86_64")]
+        #[target_feature(enable = $feature)]
+        #[allow(clippy::too_many_arguments)]
+        fn $name(
+            src: &[f32],
+            out: &mut [f32],
+            w: usize,
+            h: usize,
+            y0: usize,
+            kernel: &Kernel,
+            s: &mut BlurScratch,
+            sparse: Option<Sparse<'_>>,
+        ) {
+            blur_rows_impl(src, out, w, h, y0, kernel, s, sparse);
+        }
+    };
 }
 
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f")]
-#[allow(clippy::too_many_arguments)]
-fn blur_rows_avx512(
-    src: &[f32],
-    out: &mut [f32],
-    w: usize,
-    h: usize,
-    y0: usize,
-    kernel: &Kernel,
-    s: &mut BlurScratch,
-    sparse: Option<Sparse<'_>>,
-) {
-    blur_rows_impl::<LANES_AVX512>(src, out, w, h, y0, kernel, s, sparse);
-}
+blur_rows_with_feature!(blur_rows_avx2, "avx2");
+blur_rows_with_feature!(blur_rows_avx512, "avx512f");
 
 /// Rows computed together: with [`CHUNK`] columns each, enough independent accumulator chains to hide
 /// the add latency, whatever the width of the active spans.
@@ -393,7 +380,7 @@ fn quad_rows(q: usize, gn: usize) -> [usize; QUAD] {
 
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
-fn blur_rows_impl<const LANES: usize>(
+fn blur_rows_impl(
     src: &[f32],
     out: &mut [f32],
     w: usize,

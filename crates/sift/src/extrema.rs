@@ -107,41 +107,31 @@ pub fn find_candidates(
     find_candidates_impl(gauss, w, h, n_layers, threshold, border, rows, mask, ring, out);
 }
 
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f")]
-#[allow(clippy::too_many_arguments)]
-fn find_candidates_avx512(
-    gauss: &[Vec<f32>],
-    w: usize,
-    h: usize,
-    n_layers: usize,
-    threshold: f32,
-    border: usize,
-    rows: std::ops::Range<usize>,
-    mask: Option<&ChunkMask>,
-    ring: &mut DogRows,
-    out: &mut Vec<Candidate>,
-) {
-    find_candidates_impl(gauss, w, h, n_layers, threshold, border, rows, mask, ring, out);
+/// A copy of `find_candidates_impl` compiled with a target feature (picked at run time by [`find_candidates`]).
+macro_rules! find_candidates_with_feature {
+    ($name:ident, $feature:literal) => {
+        #[cfg(target_arch = "x86_64")]
+        #[target_feature(enable = $feature)]
+        #[allow(clippy::too_many_arguments)]
+        fn $name(
+            gauss: &[Vec<f32>],
+            w: usize,
+            h: usize,
+            n_layers: usize,
+            threshold: f32,
+            border: usize,
+            rows: std::ops::Range<usize>,
+            mask: Option<&ChunkMask>,
+            ring: &mut DogRows,
+            out: &mut Vec<Candidate>,
+        ) {
+            find_candidates_impl(gauss, w, h, n_layers, threshold, border, rows, mask, ring, out);
+        }
+    };
 }
 
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-#[allow(clippy::too_many_arguments)]
-fn find_candidates_avx2(
-    gauss: &[Vec<f32>],
-    w: usize,
-    h: usize,
-    n_layers: usize,
-    threshold: f32,
-    border: usize,
-    rows: std::ops::Range<usize>,
-    mask: Option<&ChunkMask>,
-    ring: &mut DogRows,
-    out: &mut Vec<Candidate>,
-) {
-    find_candidates_impl(gauss, w, h, n_layers, threshold, border, rows, mask, ring, out);
-}
+find_candidates_with_feature!(find_candidates_avx512, "avx512f");
+find_candidates_with_feature!(find_candidates_avx2, "avx2");
 
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
