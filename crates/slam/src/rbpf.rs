@@ -326,7 +326,10 @@ impl Rbpf {
             let prior = &prior;
             // Each particle's match is independent of the others': computed in parallel, collected in order,
             // so results do not depend on the number of threads (the scratch holds only rebuilt data).
-            let starts: Vec<Xyt> = self.particles.iter().map(|q| q.pose).collect();
+            // The calibration learns from where each match started and the information at its end.
+            let calibrating = self.params.odometry_calibration > 0.0;
+            let starts: Vec<Xyt> =
+                if calibrating { self.particles.iter().map(|q| q.pose).collect() } else { Vec::new() };
             let results: Vec<MatchResult> = self
                 .particles
                 .par_iter()
@@ -334,7 +337,8 @@ impl Rbpf {
                     matcher.match_scan(&part.map, &part.pose, prepared, Some(prior), scratch)
                 })
                 .collect();
-            let information: Vec<Option<([f64; 6], [f64; 6])>> = results.iter().map(|m| m.information).collect();
+            let information: Vec<Option<([f64; 6], [f64; 6])>> =
+                if calibrating { results.iter().map(|m| m.information).collect() } else { Vec::new() };
             for (part, m) in self.particles.iter_mut().zip(results) {
                 if m.accepted {
                     matched_particles += 1;
@@ -349,7 +353,7 @@ impl Rbpf {
             let (w, ne) = normalize(&logw, gain);
             neff = ne;
             self.weights = w;
-            if self.params.odometry_calibration > 0.0 {
+            if calibrating {
                 self.calibrate(&starts, &information);
             }
             if neff < self.params.resample_threshold * n as f64 {
