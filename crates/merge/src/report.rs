@@ -1,4 +1,4 @@
-//! The merge report: what `--report` writes, as ../shared/DESIGN.md specifies it.
+//! The merge report: what `--report` writes, laid out in ARCHITECTURE.md, "Merge report".
 
 use mrslam_core::{Pose2, pose, pose_xyt};
 use std::collections::BTreeMap;

@@ -6,7 +6,7 @@
 //! data handed over by the simulation loop, and [`pair::record_pair`] a stand-alone merge of two maps.
 //! [`inspect::summarize`] reads a recording back with rerun's own decoder.
 //!
-//! Entity paths (../shared/DESIGN.md): `world/{walls,truth_map}`,
+//! Entity paths (ARCHITECTURE.md, "Recordings"): `world/{walls,truth_map}`,
 //! `robots/<name>/{truth,truth/path,odom,odom/path,slam/pose,slam/path,slam/particles,scan}`, `maps/<name>`,
 //! `merge/<algorithm>/{keypoints/<name>,matches,merged}`, `metrics/{error,neff,slip}/...`, `events`; timelines
 //! `sim_time` (seconds) and `step`. Nothing here runs unless a recording was asked for.

@@ -1,4 +1,4 @@
-//! The entity paths of a recording (../shared/DESIGN.md, conventions), built from parts so that any robot or
+//! The entity paths of a recording (ARCHITECTURE.md, "Recordings"), built from parts so that any robot or
 //! algorithm name is one path part whatever characters it holds.
 
 use rerun::EntityPath;
