@@ -28,6 +28,9 @@ enum Command {
     /// Inspect CARMEN laser logs.
     #[command(subcommand)]
     Log(cmd::log::LogCommand),
+    /// Evaluate results: a trajectory against benchmark relations.
+    #[command(subcommand)]
+    Eval(cmd::eval::EvalCommand),
     /// Run a scenario end to end: simulate both robots, map, merge, evaluate against truth.
     Run(cmd::run::RunArgs),
     /// Map a CARMEN log with GMapping-style particle filter SLAM.
@@ -42,6 +45,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Map(c) => cmd::map::run(c),
         Command::Log(c) => cmd::log::run(c),
+        Command::Eval(c) => cmd::eval::run(c),
         Command::Merge(a) => cmd::merge::run(a),
         Command::Features(a) => cmd::features::run(a),
         Command::Slam(a) => cmd::slam::run(a),

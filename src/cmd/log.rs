@@ -1,46 +1,100 @@
-//! `mrslam log info`: what a CARMEN laser log holds.
+//! `mrslam log info`: what a CARMEN laser log holds, and what the reader repaired.
 
 use anyhow::Result;
-use clap::Subcommand;
-use mrslam_core::CarmenLog;
-use std::path::PathBuf;
+use clap::{Args, Subcommand};
+use mrslam_core::carmen::MAX_STEP_BACK;
+use mrslam_core::{CarmenLog, OdometrySource, ReadOptions};
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+
+/// How a log is read (shared by `log info` and `slam`).
+#[derive(Args, Debug, Clone)]
+pub struct ReadArgs {
+    /// Each scan's odometry: `interpolated` (ODOM lines interpolated at the scan's stamp where they bracket
+    /// it, else the scan line's own fields) or `line` (the scan line's own odometry fields, as GMapping).
+    #[arg(long, default_value_t = OdometrySource::Interpolated)]
+    pub odometry: OdometrySource,
+    /// Refuse a log whose sensor stamps step back by more than this many seconds (real logs interleave
+    /// sensors by arrival: up to about 1 s).
+    #[arg(long, default_value_t = MAX_STEP_BACK)]
+    pub max_step_back: f64,
+    /// Keep ODOM increments that report reversing (tv < 0) but move forwards as they are (by default they
+    /// are turned round: some robots' odometry integrates the speed's magnitude).
+    #[arg(long)]
+    pub keep_reversing: bool,
+    /// Seconds by which each scan was taken before its stamp: odometry is interpolated at the stamp minus
+    /// this.
+    #[arg(long, default_value_t = 0.0)]
+    pub scan_latency: f64,
+}
+
+impl ReadArgs {
+    /// Reads `path` with these options.
+    pub fn read(&self, path: &Path) -> Result<CarmenLog> {
+        if !(self.max_step_back.is_finite() && self.max_step_back >= 0.0) {
+            anyhow::bail!("--max-step-back {}: must be a non-negative number of seconds", self.max_step_back);
+        }
+        if !(self.scan_latency.is_finite() && self.scan_latency.abs() <= 10.0) {
+            anyhow::bail!("--scan-latency {}: must be a number of seconds within ±10", self.scan_latency);
+        }
+        let options = ReadOptions {
+            odometry: self.odometry,
+            max_step_back: self.max_step_back,
+            repair_reversing: !self.keep_reversing,
+            scan_latency: self.scan_latency,
+        };
+        Ok(CarmenLog::read_with(path, &options)?)
+    }
+}
 
 /// Log subcommands.
 #[derive(Subcommand)]
 pub enum LogCommand {
-    /// Print the scans, odometry readings, laser geometry and skipped lines of a CARMEN log (.gz ok).
+    /// Print a CARMEN log's scans, laser, odometry, timing, skipped lines and repairs (.gz ok).
     Info {
         /// CARMEN log file (plain or gzipped).
         log: PathBuf,
+        /// How to read it.
+        #[command(flatten)]
+        read: ReadArgs,
     },
 }
 
 /// Runs a log subcommand.
 pub fn run(cmd: LogCommand) -> Result<ExitCode> {
     match cmd {
-        LogCommand::Info { log } => {
-            let parsed = CarmenLog::read(&log)?;
+        LogCommand::Info { log, read } => {
+            let parsed = read.read(&log)?;
             println!("log:       {}", log.display());
             println!("scans:     {}", parsed.scans.len());
             if let (Some(first), Some(last)) = (parsed.scans.first(), parsed.scans.last()) {
                 let s = &first.scan;
+                let duration = last.scan.stamp - s.stamp;
+                println!("time:      {:.3} s to {:.3} s ({duration:.1} s)", s.stamp, last.scan.stamp);
+                if duration > 0.0 {
+                    println!("scan rate: {:.2} Hz", (parsed.scans.len() - 1) as f64 / duration);
+                }
+                let fov = s.angle_increment.abs() * (s.len().max(1) - 1) as f64;
                 println!(
-                    "time:      {:.3} s to {:.3} s ({:.1} s)",
-                    s.stamp,
-                    last.scan.stamp,
-                    last.scan.stamp - s.stamp
-                );
-                println!(
-                    "laser:     {} beams from {:.2} deg every {:.3} deg, range {}..{} m",
+                    "laser:     {} beams spanning {:.1} deg from {:.2} deg every {:.3} deg, range {}..{} m",
                     s.len(),
+                    fov.to_degrees(),
                     s.angle_min.to_degrees(),
                     s.angle_increment.to_degrees(),
                     s.range_min,
                     s.range_max
                 );
+                let counts: std::collections::BTreeSet<usize> = parsed.scans.iter().map(|r| r.scan.len()).collect();
+                if counts.len() > 1 {
+                    println!("           beam counts differ between scans: {counts:?}");
+                }
             }
-            println!("odometry:  {} ODOM lines", parsed.odometry.len());
+            println!(
+                "odometry:  {} ODOM lines; scans use {}",
+                parsed.odometry.len(),
+                parsed.repairs.describe_odometry()
+            );
+            println!("repairs:   {}", parsed.repairs.describe());
             println!("params:    {}", parsed.params.len());
             let skipped: Vec<String> = parsed.skipped.iter().map(|(k, n)| format!("{n} {k}")).collect();
             println!("skipped:   {}", if skipped.is_empty() { "none".to_string() } else { skipped.join(", ") });

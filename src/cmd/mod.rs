@@ -1,5 +1,6 @@
 //! One module per subcommand.
 
+pub mod eval;
 pub mod features;
 pub mod log;
 pub mod map;
@@ -24,4 +25,30 @@ pub fn check_output(path: &Path) -> Result<()> {
         bail!("{}: cannot write there: folder {} does not exist", path.display(), dir.display());
     }
     Ok(())
+}
+
+/// Fails when `output` names the same file as one of `inputs`: an output never overwrites an input.
+pub fn check_not_input(output: &Path, inputs: &[&Path]) -> Result<()> {
+    let resolve = |p: &Path| -> Option<std::path::PathBuf> {
+        if let Ok(c) = p.canonicalize() {
+            return Some(c);
+        }
+        let dir = p.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
+        Some(dir.canonicalize().ok()?.join(p.file_name()?))
+    };
+    let Some(out) = resolve(output) else { return Ok(()) };
+    for input in inputs {
+        if resolve(input).as_deref() == Some(out.as_path()) {
+            bail!("{}: refusing to write an output over the input {}", output.display(), input.display());
+        }
+    }
+    Ok(())
+}
+
+/// The process's peak resident memory, bytes (Linux: VmHWM of /proc/self/status; `None` elsewhere).
+pub fn peak_memory_bytes() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib * 1024)
 }

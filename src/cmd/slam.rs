@@ -1,32 +1,22 @@
 //! `mrslam slam LOG -o MAP.yaml`: GMapping-style SLAM on a CARMEN log.
 //!
 //! Leniency: NaN/negative beams are counted and ignored; scans whose odometry did not move enough are
-//! skipped (counted). Errors naming the log line: a malformed line (core's reader), time going backwards in
-//! file order, non-finite odometry or scan geometry.
+//! skipped (counted); sensor lines out of stamp order are reordered and repeated scans dropped (core's reader,
+//! counted and reported). Errors naming the log line: a malformed line, stamps stepping back by more than
+//! `--max-step-back`, non-finite odometry or scan geometry.
 
 use anyhow::{Context, Result, bail};
-use clap::{Args, ValueEnum};
+use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use mrslam_core::map_io::{self, write_file_atomic};
-use mrslam_core::pose::pose_xyt;
-use mrslam_core::{CarmenLog, Odometry, Pose2};
+use mrslam_core::relations::{self, StampedPose};
+use mrslam_core::{Odometry, Pose2};
 use mrslam_slam::synthetic::{Drift, inject_drift};
-use mrslam_slam::{Rbpf, SlamParams};
-use std::fmt::Write as _;
+use mrslam_slam::{Preset, Rbpf, poses_at_every_scan};
+use serde_json::json;
 use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::process::ExitCode;
-
-/// Parameter presets.
-#[derive(Clone, Copy, Debug, ValueEnum)]
-pub enum Preset {
-    /// GMapping's defaults (80 m range, update every 1 m / 0.5 rad).
-    Gmapping,
-    /// Hokuyo URG-04LX class robot (4 m).
-    Hokuyo,
-    /// RpLidar A1 class robot (6 m).
-    Rplidar,
-}
 
 /// Arguments of `mrslam slam`.
 #[derive(Args, Debug)]
@@ -36,11 +26,25 @@ pub struct SlamArgs {
     /// Output map YAML (a PGM is written beside it).
     #[arg(short, long)]
     pub output: PathBuf,
-    /// Output trajectory: one line per processed scan, `timestamp x y theta` (best particle, map frame).
+    /// Output trajectory: one pose per scan of the log, in stamp order, `stamp x y theta` (best particle,
+    /// map frame; scans the filter did not process are placed by odometry, see the file's header).
     #[arg(long)]
     pub trajectory: Option<PathBuf>,
-    /// Parameter preset.
-    #[arg(long, value_enum, default_value_t = Preset::Gmapping)]
+    /// Score the trajectory against these benchmark relations (Kümmerle et al. 2009) at the end.
+    #[arg(long)]
+    pub relations: Option<PathBuf>,
+    /// Relation stamps match a scan's stamp within this many seconds.
+    #[arg(long, default_value_t = super::eval::DEFAULT_TOLERANCE)]
+    pub tolerance: f64,
+    /// Write a JSON summary of the run here: scans, processed, time, real-time factor, peak memory,
+    /// resamples, repairs and (with --relations) the metric.
+    #[arg(long)]
+    pub summary: Option<PathBuf>,
+    /// How to read the log.
+    #[command(flatten)]
+    pub read: super::log::ReadArgs,
+    /// Parameter preset: gmapping, hokuyo or rplidar.
+    #[arg(long, default_value_t = Preset::Gmapping)]
     pub preset: Preset,
     /// Number of particles.
     #[arg(long)]
@@ -77,14 +81,17 @@ pub struct SlamArgs {
 
 /// Runs `mrslam slam`.
 pub fn run(args: SlamArgs) -> Result<ExitCode> {
-    for p in std::iter::once(&args.output).chain(&args.trajectory) {
+    let outputs = [Some(&args.output), args.trajectory.as_ref(), args.summary.as_ref()];
+    for p in outputs.into_iter().flatten() {
         super::check_output(p)?;
+        let inputs: Vec<&std::path::Path> =
+            std::iter::once(args.log.as_path()).chain(args.relations.as_deref()).collect();
+        super::check_not_input(p, &inputs)?;
     }
-    let mut params = match args.preset {
-        Preset::Gmapping => SlamParams::default(),
-        Preset::Hokuyo => SlamParams::hokuyo(),
-        Preset::Rplidar => SlamParams::rplidar(),
-    };
+    if !(args.tolerance.is_finite() && args.tolerance >= 0.0) {
+        bail!("--tolerance {}: must be a non-negative number of seconds", args.tolerance);
+    }
+    let mut params = args.preset.params();
     if let Some(n) = args.particles {
         params.particles = n;
     }
@@ -104,24 +111,14 @@ pub fn run(args: SlamArgs) -> Result<ExitCode> {
         params.set(name.trim(), value).map_err(|e| anyhow::anyhow!("--set {kv}: {e}"))?;
     }
     params.validate().map_err(|e| anyhow::anyhow!("slam parameters: {e}"))?;
-    let log = CarmenLog::read(&args.log)?;
+    // Read the relations before the long work, so that a bad file costs nothing.
+    let rels = match &args.relations {
+        Some(p) => Some(relations::read_relations(p)?),
+        None => None,
+    };
+    let log = args.read.read(&args.log)?;
     if log.scans.is_empty() {
         bail!("{}: no laser scans in the log", args.log.display());
-    }
-    // Time going backwards in file order is an error naming the line (the reader sorts by stamp).
-    let mut by_line: Vec<(usize, f64)> = log.scans.iter().map(|r| (r.line, r.scan.stamp)).collect();
-    by_line.sort_by_key(|&(l, _)| l);
-    for w in by_line.windows(2) {
-        if w[1].1 < w[0].1 {
-            bail!(
-                "{}:{}: time goes backwards: stamp {} after {} on line {}",
-                args.log.display(),
-                w[1].0,
-                w[1].1,
-                w[0].1,
-                w[0].0
-            );
-        }
     }
     let mut odo: Vec<Odometry> = log.scans.iter().map(|r| r.odometry).collect();
     let drift = Drift {
@@ -145,10 +142,14 @@ pub fn run(args: SlamArgs) -> Result<ExitCode> {
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
     let start = std::time::Instant::now();
-    for (rec, o) in log.scans.iter().zip(&odo) {
+    let mut processed: Vec<usize> = Vec::new();
+    for (i, (rec, o)) in log.scans.iter().zip(&odo).enumerate() {
         let out = filter.process(o, &rec.scan).with_context(|| format!("{}:{}", args.log.display(), rec.line))?;
         if let Some(neff) = out.neff() {
             bar.set_message(format!("Neff {neff:.1}"));
+        }
+        if out.is_processed() {
+            processed.push(i);
         }
         bar.inc(1);
     }
@@ -156,16 +157,40 @@ pub fn run(args: SlamArgs) -> Result<ExitCode> {
     let secs = start.elapsed().as_secs_f64();
     let map = filter.map().context("building the map")?;
     map_io::write_ros_map(&map, &args.output).with_context(|| format!("{}", args.output.display()))?;
-    if let Some(path) = &args.trajectory {
-        let mut text = String::new();
-        for (stamp, p) in filter.trajectory() {
-            let (x, y, t) = pose_xyt(&p);
-            let _ = writeln!(text, "{stamp:.6} {x:.6} {y:.6} {t:.6}");
-        }
-        write_file_atomic(path, text.as_bytes()).with_context(|| format!("{}", path.display()))?;
+
+    // A pose for every scan: the filter's at the processed ones, odometry in between.
+    let keyframes = filter.trajectory();
+    if keyframes.len() != processed.len() {
+        bail!("internal: {} trajectory nodes for {} processed scans", keyframes.len(), processed.len());
     }
+    let stamps: Vec<f64> = log.scans.iter().map(|r| r.scan.stamp).collect();
+    let odometry: Vec<Pose2> = odo.iter().map(|o| o.pose).collect();
+    let anchors: Vec<(usize, Pose2)> = processed.iter().copied().zip(keyframes.iter().map(|k| k.1)).collect();
+    let poses =
+        poses_at_every_scan(&stamps, &odometry, &anchors).context("the filter processed no scan: no trajectory")?;
+    let trajectory: Vec<StampedPose> =
+        stamps.iter().zip(&poses).map(|(&stamp, &pose)| StampedPose { stamp, pose }).collect();
+    if let Some(path) = &args.trajectory {
+        let header = format!(
+            "mrslam slam {}: one pose per scan ({} scans), `stamp x y theta`, the best particle's robot pose in \
+             the map frame.\n{} scans were processed by the filter and carry its pose; every other scan is placed \
+             by the odometry from the processed scan before it and back from the processed scan after it, blended \
+             by time (before the first / after the last processed scan: odometry from it).",
+            args.log.display(),
+            trajectory.len(),
+            processed.len()
+        );
+        write_file_atomic(path, relations::format_trajectory(&header, &trajectory).as_bytes())?;
+    }
+    let score = rels.as_ref().map(|r| relations::score(&trajectory, r, args.tolerance));
+
     let c = filter.counters();
     let (free, occ, unknown) = map.state_counts();
+    let duration = stamps[stamps.len() - 1] - stamps[0];
+    let realtime = if secs > 0.0 { duration / secs } else { f64::INFINITY };
+    let peak = super::peak_memory_bytes();
+    println!("log: {} ({:.1} s); {}", args.log.display(), duration, log.repairs.describe());
+    println!("odometry: {}", log.repairs.describe_odometry());
     println!(
         "slam: {} scans: {} processed, {} skipped (not moved {}, empty {}), {} invalid beams ignored, {} resamples",
         c.readings,
@@ -177,8 +202,9 @@ pub fn run(args: SlamArgs) -> Result<ExitCode> {
         c.resamples
     );
     println!(
-        "time {secs:.2} s ({:.1} ms per processed scan), final Neff {:.1} of {}",
+        "time {secs:.2} s ({:.1} ms per processed scan, {realtime:.1}x real time), peak memory {}, final Neff {:.1} of {}",
         secs * 1e3 / c.processed.max(1) as f64,
+        peak.map_or("unknown".to_string(), |b| format!("{:.0} MiB", b as f64 / (1024.0 * 1024.0))),
         filter.neff(),
         filter.params().particles
     );
@@ -197,5 +223,37 @@ pub fn run(args: SlamArgs) -> Result<ExitCode> {
         map.height(),
         map.resolution()
     );
+    if let Some(score) = &score {
+        print!("{}", super::eval::describe(score, args.tolerance, 3));
+    }
+    if let Some(path) = &args.summary {
+        let r = &log.repairs;
+        let summary = json!({
+            "log": args.log.display().to_string(),
+            "preset": args.preset.to_string(),
+            "seed": args.seed,
+            "particles": filter.params().particles,
+            "scans": c.readings,
+            "processed": c.processed,
+            "resamples": c.resamples,
+            "log_duration_s": duration,
+            "time_s": secs,
+            "real_time_factor": realtime,
+            "ms_per_scan": secs * 1e3 / c.readings.max(1) as f64,
+            "peak_memory_bytes": peak,
+            "repairs": {
+                "out_of_order": r.out_of_order,
+                "max_step_back_s": r.max_step_back,
+                "duplicate_scans": r.duplicate_scans,
+                "shared_scan_stamps": r.shared_scan_stamps,
+                "duplicate_odometry": r.duplicate_odometry,
+                "reversed_increments": r.reversed_increments,
+                "interpolated_odometry": r.interpolated_odometry,
+                "line_odometry": r.line_odometry,
+            },
+            "metric": score.as_ref().map(|s| super::eval::to_json(s, args.tolerance, 10)),
+        });
+        super::eval::write_json(path, &summary)?;
+    }
     Ok(ExitCode::SUCCESS)
 }

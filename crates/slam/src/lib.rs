@@ -16,6 +16,7 @@
 
 mod calibration;
 pub mod error;
+pub mod every_scan;
 pub mod field;
 pub mod map_build;
 pub mod motion;
@@ -28,5 +29,6 @@ pub mod synthetic;
 pub mod tile_map;
 
 pub use error::SlamError;
-pub use params::SlamParams;
+pub use every_scan::poses_at_every_scan;
+pub use params::{Preset, SlamParams};
 pub use rbpf::{MemoryStats, Rbpf, SkipReason, UpdateOutcome, UpdateStats};

@@ -349,6 +349,57 @@ impl SlamParams {
     }
 }
 
+/// A named set of parameters: what `--preset` and scenario files choose by name.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Preset {
+    /// GMapping's defaults ([`SlamParams::default`]).
+    #[default]
+    Gmapping,
+    /// Experia's Hokuyo URG-04LX class lidar ([`SlamParams::hokuyo`]).
+    Hokuyo,
+    /// Prawn's RpLidar A1 class lidar ([`SlamParams::rplidar`]).
+    Rplidar,
+}
+
+impl Preset {
+    /// Every preset, in the order help texts list them.
+    pub const ALL: [Preset; 3] = [Preset::Gmapping, Preset::Hokuyo, Preset::Rplidar];
+
+    /// The preset's parameters.
+    pub fn params(self) -> SlamParams {
+        match self {
+            Preset::Gmapping => SlamParams::default(),
+            Preset::Hokuyo => SlamParams::hokuyo(),
+            Preset::Rplidar => SlamParams::rplidar(),
+        }
+    }
+
+    /// The preset's name, as `FromStr` reads it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Preset::Gmapping => "gmapping",
+            Preset::Hokuyo => "hokuyo",
+            Preset::Rplidar => "rplidar",
+        }
+    }
+}
+
+impl std::fmt::Display for Preset {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for Preset {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        Preset::ALL.into_iter().find(|p| p.name() == s).ok_or_else(|| {
+            let names: Vec<&str> = Preset::ALL.iter().map(|p| p.name()).collect();
+            format!("unknown SLAM preset `{s}` (expected {})", names.join(", "))
+        })
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -371,6 +422,15 @@ mod tests {
         assert!(p.validate().is_ok());
         assert!(SlamParams::hokuyo().validate().is_ok());
         assert!(SlamParams::rplidar().validate().is_ok());
+    }
+
+    #[test]
+    fn presets_round_trip_by_name() {
+        for p in Preset::ALL {
+            assert_eq!(p.name().parse::<Preset>(), Ok(p));
+            assert!(p.params().validate().is_ok());
+        }
+        assert_eq!("x".parse::<Preset>().unwrap_err(), "unknown SLAM preset `x` (expected gmapping, hokuyo, rplidar)");
     }
 
     #[test]
