@@ -1,4 +1,5 @@
 //! The `map` and `log` commands, run as a user would: good input, and every kind of bad input.
+#![allow(clippy::unwrap_used, reason = "test code: a failed unwrap fails the test")]
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};

@@ -1,4 +1,5 @@
 //! `mrslam merge` and `mrslam map cut`, run as a user would.
+#![allow(clippy::unwrap_used, reason = "test code: a failed unwrap fails the test")]
 
 use mrslam_core::map_io::{read_ros_map, write_ros_map};
 use mrslam_merge::floorplan::{FloorplanParams, generate};

@@ -1,4 +1,5 @@
 //! `mrslam run`, as a user would: bad scenarios are refused with the file, line and field named.
+#![allow(clippy::unwrap_used, reason = "test code: a failed unwrap fails the test")]
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};

@@ -1,6 +1,8 @@
 //! `mrslam slam` run as a user would: a CARMEN log of a drifting robot in, a map and a trajectory out that
 //! beat the odometry against the truth; bad logs and bad parameters refused, naming the line or the parameter.
 
+#![allow(clippy::unwrap_used, reason = "test code: a failed unwrap fails the test")]
+
 use mrslam_core::Pose2;
 use mrslam_core::pose::{pose_xyt, relative};
 use mrslam_slam::synthetic::{self, Drift, Lidar, SyntheticRun};

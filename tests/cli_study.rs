@@ -1,4 +1,5 @@
 //! `mrslam study`, as a user would: a small map-level study, its files, its shards, and bad input.
+#![allow(clippy::unwrap_used, reason = "test code: a failed unwrap fails the test")]
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};

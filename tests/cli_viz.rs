@@ -1,6 +1,7 @@
 //! `mrslam run ... --rrd` and `mrslam merge ... --rrd`, as a user would: the recording is read back with rerun's
 //! own decoder (through `mrslam_viz::inspect`), and must hold the designed entity paths and timelines with
 //! plausible counts, identical bytes on a second run, and bad destinations must fail before any work.
+#![allow(clippy::unwrap_used, reason = "test code: a failed unwrap fails the test")]
 
 use mrslam_core::map_io::write_ros_map;
 use mrslam_merge::floorplan::{FloorplanParams, generate};

@@ -1,5 +1,6 @@
 //! The paper's two experiments, and the second one explored autonomously, end to end in simulation, checked
 //! against ground truth.
+#![allow(clippy::unwrap_used, reason = "test code: a failed unwrap fails the test")]
 
 use mrslam_testbed::report::RunReport;
 use mrslam_testbed::runner::{RunOptions, run, write_outputs};

@@ -2,12 +2,13 @@
 
 use anyhow::{Context, Result, bail};
 use clap::Args;
+use clap::builder::{PossibleValuesParser, TypedValueParser};
 use mrslam_core::OccupancyGrid;
 use mrslam_core::map_io::{self, write_file_atomic};
 use mrslam_merge::map_image::MapImage;
 use mrslam_merge::{
-    Evidence, FusionRule, MapEncoding, MatchParams, MergeParams, MergeReport, Merger, Model, RmapMerger, RmapParams,
-    SiftMerger, SiftMergerParams, merge,
+    Algorithm, Evidence, FusionRule, MapEncoding, MatchParams, MergeParams, MergeReport, Merger, Model, RmapMerger,
+    RmapParams, SiftMerger, SiftMergerParams, merge,
 };
 use mrslam_testbed::runner::merge_view;
 use mrslam_viz::pair::record_pair;
@@ -28,8 +29,8 @@ pub struct MergeArgs {
     #[arg(long)]
     pub report: Option<PathBuf>,
     /// Merge algorithm: `sift` (the paper's, Alg. 3) or `rmap` (Park's R-map baseline, Alg. 1).
-    #[arg(long, default_value = "sift", value_parser = ["sift", "rmap"])]
-    pub algorithm: String,
+    #[arg(long, default_value = "sift", value_parser = algorithm_parser())]
+    pub algorithm: Algorithm,
     /// Transform model: rigid, similarity or homography (the paper's; its rigid part is used).
     #[arg(long, default_value = "rigid")]
     pub model: Model,
@@ -68,6 +69,11 @@ pub struct MergeArgs {
     pub viz: super::viz::VizArgs,
 }
 
+/// Reads `--algorithm`: a name of [`Algorithm::ALL`], each listed in `--help`.
+fn algorithm_parser() -> impl TypedValueParser<Value = Algorithm> {
+    PossibleValuesParser::new(Algorithm::ALL.map(Algorithm::name)).try_map(|s| s.parse::<Algorithm>())
+}
+
 /// Runs `mrslam merge`.
 pub fn run(args: MergeArgs) -> Result<ExitCode> {
     for p in [&args.output, &args.report, &args.matches_png].into_iter().flatten() {
@@ -92,14 +98,13 @@ pub fn run(args: MergeArgs) -> Result<ExitCode> {
         ..Default::default()
     };
     params.ransac.seed = args.seed;
-    let merger: Box<dyn Merger> = match args.algorithm.as_str() {
-        "sift" => Box::new(SiftMerger::new(params)),
-        "rmap" => {
+    let merger: Box<dyn Merger> = match args.algorithm {
+        Algorithm::Sift => Box::new(SiftMerger::new(params)),
+        Algorithm::Rmap => {
             let mut rp = RmapParams::default();
             rp.orient.seed = args.seed;
             Box::new(RmapMerger::new(rp))
         }
-        other => bail!("unknown algorithm `{other}`"),
     };
     let mp = MergeParams { verify_enabled: !args.no_verify, fusion: args.fusion, ..MergeParams::default() };
     let out = merge(merger.as_ref(), &a, &b, &mp);

@@ -3,8 +3,9 @@
 use anyhow::{Result, bail};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use mrslam_merge::Algorithm;
 use mrslam_testbed::runner::{RunOptions, run as run_scenario, write_outputs};
-use mrslam_testbed::scenario::{ALGORITHMS, Scenario};
+use mrslam_testbed::scenario::Scenario;
 use mrslam_viz::RunRecorder;
 use std::io::IsTerminal;
 use std::path::PathBuf;
@@ -15,7 +16,7 @@ use std::process::ExitCode;
 pub struct RunArgs {
     /// Scenario file (TOML), e.g. scenarios/paper_corridor.toml.
     pub scenario: PathBuf,
-    /// Output folder (default: out/<scenario name>).
+    /// Output folder (default: out/NAME, NAME being the scenario's name).
     #[arg(long)]
     pub out: Option<PathBuf>,
     /// Merge algorithm to run instead of the scenario's: one name, or `all` to compare them on the same maps.
@@ -40,9 +41,11 @@ pub fn run(args: RunArgs) -> Result<ExitCode> {
     }
     let algorithms = match args.algorithm.as_deref() {
         None => None,
-        Some("all") => Some(ALGORITHMS.iter().map(|s| s.to_string()).collect()),
-        Some(a) if ALGORITHMS.contains(&a) => Some(vec![a.to_string()]),
-        Some(a) => bail!("--algorithm {a}: unknown (expected {} or all)", ALGORITHMS.join(", ")),
+        Some("all") => Some(Algorithm::ALL.to_vec()),
+        Some(a) => match a.parse::<Algorithm>() {
+            Ok(a) => Some(vec![a]),
+            Err(_) => bail!("--algorithm {a}: unknown (expected {} or all)", Algorithm::names()),
+        },
     };
     let out_dir = args.out.clone().unwrap_or_else(|| PathBuf::from("out").join(&scenario.name));
     // Fail before a long run if the output folder cannot be made.

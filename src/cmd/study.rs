@@ -181,7 +181,7 @@ fn overlap(a: OverlapArgs) -> Result<ExitCode> {
         source,
         overlaps,
         trials: a.trials,
-        algorithms: a.algorithms.iter().map(|s| s.trim().to_string()).collect(),
+        algorithms: study::parse_algorithms(&a.algorithms.iter().map(|s| s.trim()).collect::<Vec<_>>())?,
         seed: a.seed,
         max_rotation_deg: a.max_rotation_deg,
         max_translation_cells: a.max_translation_cells,
@@ -210,8 +210,11 @@ fn scenario(a: ScenarioArgs) -> Result<ExitCode> {
             sweep.trials(),
             sweep.variants(),
             sweep.seeds.len(),
-            sweep.algorithms.join(",")
+            sweep.algorithms.iter().map(|a| a.name()).collect::<Vec<_>>().join(",")
         );
+        if let Some(d) = &sweep.scenario.description {
+            println!("  {d}");
+        }
         for t in (0..sweep.trials()).filter(|t| shard.selects(*t)) {
             println!("trial {t}: {}", sweep.describe(t));
         }

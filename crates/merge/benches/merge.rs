@@ -1,4 +1,5 @@
 //! End-to-end merge of two 600×600 maps, single-threaded, and its stages.
+#![allow(missing_docs, reason = "criterion_group! defines an undocumented public function")]
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use mrslam_merge::floorplan::{FloorplanParams, generate};

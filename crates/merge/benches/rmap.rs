@@ -1,5 +1,6 @@
 //! The R-map baseline (paper Alg. 1) beside the SIFT merger (Alg. 3) on the same 300×300 pair, both
 //! single-threaded through the full `merge` pipeline; and the R-map of a 600×600 map alone.
+#![allow(missing_docs, reason = "criterion_group! defines an undocumented public function")]
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use mrslam_merge::floorplan::{FloorplanParams, generate};

@@ -72,7 +72,7 @@ pub struct NoAlignment {
 
 /// A map-merging algorithm: finds the transform between two occupancy grids of unknown relative pose.
 pub trait Merger: Send + Sync {
-    /// Short name used in reports and on the command line (`sift`, `rmap`).
+    /// Short name used in reports and on the command line: [`crate::Algorithm::name`] for this crate's mergers.
     fn name(&self) -> &'static str;
     /// Estimates `T_a_b`, or says why it cannot.
     fn align(&self, a: &OccupancyGrid, b: &OccupancyGrid) -> Result<Alignment, Box<NoAlignment>>;

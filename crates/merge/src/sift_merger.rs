@@ -117,7 +117,7 @@ fn map_features(grid: &OccupancyGrid, p: &SiftMergerParams) -> (Features, Vec<Po
 
 impl Merger for SiftMerger {
     fn name(&self) -> &'static str {
-        "sift"
+        crate::Algorithm::Sift.name()
     }
 
     fn align(&self, a: &OccupancyGrid, b: &OccupancyGrid) -> Result<Alignment, Box<NoAlignment>> {

@@ -1,10 +1,11 @@
 //! Criterion benchmark: detect + compute on the 1024x1024 map-like and textured synthetic images.
+#![allow(missing_docs, reason = "criterion_group! defines an undocumented public function")]
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use mrslam_sift::{GrayImage, Sift, SiftParams};
 use std::hint::black_box;
 
-#[path = "../tests/common/synth.rs"]
+#[path = "../src/synth.rs"]
 mod synth;
 
 fn bench(c: &mut Criterion) {

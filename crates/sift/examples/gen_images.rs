@@ -2,7 +2,7 @@
 //!
 //! usage: cargo run -p mrslam-sift --release --example gen_images -- DIR
 
-#[path = "../tests/common/synth.rs"]
+#[path = "../src/synth.rs"]
 mod synth;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {

@@ -253,7 +253,7 @@ const QUAD: usize = 4;
 unsafe fn vquad(src: &[f32], t: &[usize], k: &[f32], x: usize) -> [[f32; CHUNK]; QUAD] {
     let r = k.len() - 1;
     let p = src.as_ptr();
-    // SAFETY (all blocks below): offsets are in bounds by the caller's contract; `CHUNK` f32 values from
+    // SAFETY: offsets are in bounds by the caller's contract; `CHUNK` f32 values from
     // an in-bounds offset form a valid `[f32; CHUNK]` (f32 has alignment 4, `p` is a slice pointer).
     let at = |m: usize| unsafe { *(p.add(*t.get_unchecked(m) + x) as *const [f32; CHUNK]) };
     // Row j's taps at distance i: `up[j]` is source row y + j - i, `dn[j]` is y + j + i.

@@ -74,7 +74,7 @@ unsafe fn window_row_avx512(
         let n = (j1 - j + 1).min(16) as u32;
         let valid: __mmask16 = if n == 16 { 0xffff } else { ((1u32 << n) - 1) as u16 };
         let c = (g.ptx + j) as usize;
-        // SAFETY (loads): lanes past `j1` are masked off, so only in-bounds elements are read; the base
+        // SAFETY: lanes past `j1` are masked off, so only in-bounds elements are read; the base
         // pointers are in bounds by the caller's contract.
         let ld = |row: &[f32], at: usize| unsafe { _mm512_maskz_loadu_ps(valid, row.as_ptr().add(at)) };
         let fj = _mm512_add_ps(_mm512_set1_ps(j as f32), lanes);

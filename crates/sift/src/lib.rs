@@ -27,9 +27,7 @@ mod params;
 mod pyramid;
 #[cfg(test)]
 mod sparse_tests;
-/// Synthetic test images and the tests' random numbers (shared with the integration tests and benches).
 #[cfg(test)]
-#[path = "../tests/common/synth.rs"]
 mod synth;
 
 pub use error::SiftError;

@@ -129,7 +129,6 @@ pub fn dog_reach(
         (err, m) = step(k, err, m);
         errs.push(err);
     }
-    let _ = m;
     // T(d) = sum of |K_{l+1} - K_l| over the 2-D offsets q with |q|_inf >= d, from the separable
     // composites (K(x, y) = k(x) k(y)), bucketed by Chebyshev radius; f64 rounding is covered by a slack.
     let tails = |a: &[f64], b: &[f64]| -> Vec<f64> {

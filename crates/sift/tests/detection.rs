@@ -1,4 +1,5 @@
 //! Behaviour on synthetic images: blobs, flat images, bad input, determinism, feature cap.
+#![allow(clippy::unwrap_used, reason = "test code: a failed unwrap fails the test")]
 
 use mrslam_sift::{GrayImage, Sift, SiftParams, detect_and_compute};
 

@@ -1,4 +1,5 @@
 //! Repeatability and descriptor matching under rotation (30°, 90°) and scaling (0.5, 2) of a textured image.
+#![allow(clippy::unwrap_used, reason = "test code: a failed unwrap fails the test")]
 
 use mrslam_sift::{Features, GrayImage, SiftParams, detect_and_compute};
 

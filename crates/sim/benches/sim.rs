@@ -1,5 +1,6 @@
 //! Simulator benchmarks: one Hokuyo scan in the corridor (grid caster vs rapier's query pipeline),
 //! and world steps per second with two robots.
+#![allow(missing_docs, reason = "criterion_group! defines an undocumented public function")]
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use mrslam_sim::{EncoderParams, LidarModel, RayBackend, RobotModel, Sim, SimConfig, SlipParams, WorldSpec};

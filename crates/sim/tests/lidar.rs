@@ -1,4 +1,5 @@
 //! Lidar: beam counts, geometry within the noise bound, range limits, no self-hits, skew, backends.
+#![allow(clippy::unwrap_used, reason = "test code: a failed unwrap fails the test")]
 
 mod common;
 

@@ -6,6 +6,7 @@
 //! (which never resamples on this corridor). `rbpf_update_30p_667beams_shared_tiles` times the same update
 //! on a clone whose every tile is still shared with another filter, so each tile it writes is copied first:
 //! the cost of an update right after a resampling.
+#![allow(missing_docs, reason = "criterion_group! defines an undocumented public function")]
 
 use criterion::{BatchSize, Criterion, criterion_group, criterion_main};
 use mrslam_core::pose;

@@ -2,6 +2,7 @@
 //! (every 5th scan, 0.25 m apart, hits plus the seen band), matching the next processed scan from perturbed
 //! starting poses. Isolates the matcher's error (and bias) from the filter's dynamics.
 //! `cargo run --release -p mrslam-slam --example matcher_lab -- [hokuyo|rplidar] [name=value ...]`
+#![allow(clippy::unwrap_used, reason = "a development aid / test: a failed unwrap names the problem")]
 
 use mrslam_core::pose;
 use mrslam_core::pose::pose_xyt;

@@ -6,6 +6,7 @@
 //! mount), `LIDAR_RANGE`, `LIDAR_FOV`, `LIDAR_NOISE`,
 //! `LIDAR_NOISE_PER_M`, `LIDAR_DROPOUT` (Hokuyo), `TRACE[=N]` (every N-th pose's error), `INCREMENTS` (per-leg increment errors of SLAM and
 //! odometry), `ALL` (every particle's error and log-likelihood).
+#![allow(clippy::unwrap_used, reason = "a development aid / test: a failed unwrap names the problem")]
 
 use mrslam_core::pose::relative;
 use mrslam_core::{CellState, OccupancyGrid, Pose2, pose};
@@ -145,7 +146,7 @@ fn main() {
         let traj = f.trajectory();
         let t_at = |stamp: f64| run.truth[run.truth.binary_search_by(|(s, _)| s.total_cmp(&stamp)).unwrap()].1;
         let o_at = |stamp: f64| run.odometry.iter().find(|o| o.stamp == stamp).unwrap().pose;
-        let (mut sum_s, mut sum_o, mut n) = ([0.0f64; 3], [0.0f64; 3], 0);
+        let (mut sum_s, mut sum_o) = ([0.0f64; 3], [0.0f64; 3]);
         let mut leg_start = 0;
         for k in 1..traj.len() {
             let (ta, tb) = (t_at(traj[k - 1].0), t_at(traj[k].0));
@@ -159,7 +160,6 @@ fn main() {
                 acc[1] += e.1;
                 acc[2] += e.2;
             }
-            n += 1;
             let turn = mrslam_core::pose::pose_xyt(&dt).2.abs() > 1e-6;
             let next_turn = k + 1 < traj.len()
                 && mrslam_core::pose::pose_xyt(&relative(&t_at(traj[k].0), &t_at(traj[k + 1].0))).2.abs() > 1e-6;
@@ -174,8 +174,7 @@ fn main() {
                     sum_o[1],
                     sum_o[2]
                 );
-                let _ = n;
-                (sum_s, sum_o, n) = ([0.0; 3], [0.0; 3], 0);
+                (sum_s, sum_o) = ([0.0; 3], [0.0; 3]);
                 leg_start = k;
             }
         }

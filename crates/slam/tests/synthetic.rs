@@ -1,4 +1,5 @@
 //! End-to-end: the filter on synthetic data with a known map, path and drifting odometry.
+#![allow(clippy::unwrap_used, reason = "a development aid / test: a failed unwrap names the problem")]
 
 use mrslam_core::pose::{pose_xyt, relative};
 use mrslam_core::{CellState, OccupancyGrid, Odometry, Pose2, pose};

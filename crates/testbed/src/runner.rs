@@ -7,8 +7,8 @@ use crate::scenario::{ControllerKind, MergeWhen, RobotSetup, Scenario};
 use mrslam_core::map_io::{self, MapIoError};
 use mrslam_core::{CellTraversal, LaserScan, OccupancyGrid, Odometry, Pose2};
 use mrslam_merge::{
-    MatchParams, MergeOutcome, MergeParams, Merger, RmapMerger, RmapParams, SiftMerger, SiftMergerParams, TransformXyt,
-    merge,
+    Algorithm, MatchParams, MergeOutcome, MergeParams, Merger, RmapMerger, RmapParams, SiftMerger, SiftMergerParams,
+    TransformXyt, merge,
 };
 use mrslam_sim::geometry::Obstacle;
 use mrslam_sim::{RobotId, Sim, SimConfig, SimError, StepEvents};
@@ -36,16 +36,16 @@ pub enum RunError {
     /// Writing outputs failed.
     #[error("{0}")]
     Io(#[from] MapIoError),
-    /// A merge algorithm name is not known.
-    #[error("unknown merge algorithm `{0}`")]
-    UnknownAlgorithm(String),
+    /// The scenario is not one a run can take (its fields are public, so it may not come from a file).
+    #[error("scenario: {0}")]
+    Scenario(String),
 }
 
 /// Options of a run that are not part of the scenario.
 #[derive(Default)]
 pub struct RunOptions<'a> {
     /// Merge algorithms to run instead of the scenario's.
-    pub algorithms: Option<Vec<String>>,
+    pub algorithms: Option<Vec<Algorithm>>,
     /// Called about once per simulated second with (simulated time, duration).
     pub progress: Option<Box<dyn FnMut(f64, f64) + 'a>>,
     /// Records the run for the rerun viewer; `None` (the default) records and converts nothing.
@@ -64,11 +64,11 @@ pub struct RunOutput {
     pub merges: Vec<MergeOutcome>,
 }
 
-/// Builds the merger a scenario names.
-pub fn merger_for(name: &str, scenario: &Scenario) -> Result<Box<dyn Merger>, RunError> {
+/// Builds `algorithm`'s merger with the scenario's merge settings, its random draws seeded by the scenario's seed.
+pub fn merger_for(algorithm: Algorithm, scenario: &Scenario) -> Box<dyn Merger> {
     let m = &scenario.merge;
-    match name {
-        "sift" => {
+    match algorithm {
+        Algorithm::Sift => {
             let mut p = SiftMergerParams {
                 model: m.model,
                 encoding: m.encoding,
@@ -78,14 +78,13 @@ pub fn merger_for(name: &str, scenario: &Scenario) -> Result<Box<dyn Merger>, Ru
                 ..SiftMergerParams::default()
             };
             p.ransac.seed = scenario.seed;
-            Ok(Box::new(SiftMerger::new(p)))
+            Box::new(SiftMerger::new(p))
         }
-        "rmap" => {
+        Algorithm::Rmap => {
             let mut p = RmapParams::default();
             p.orient.seed = scenario.seed;
-            Ok(Box::new(RmapMerger::new(p)))
+            Box::new(RmapMerger::new(p))
         }
-        other => Err(RunError::UnknownAlgorithm(other.to_string())),
     }
 }
 
@@ -159,9 +158,24 @@ fn mark_observed(observed: &mut [bool], truth: &OccupancyGrid, scan: &LaserScan,
     }
 }
 
+/// The host robot's name and the other's: a run takes two robots of distinct names, one of them the host.
+///
+/// [`Scenario::from_file`] checks this; a scenario built or changed in code may not hold to it.
+fn merge_pair(scenario: &Scenario) -> Result<(String, String), RunError> {
+    let host = &scenario.merge.host;
+    match scenario.robots.as_slice() {
+        [a, b] if a.name == b.name => Err(RunError::Scenario(format!("the two robots share the name `{}`", a.name))),
+        [a, b] if a.name == *host => Ok((a.name.clone(), b.name.clone())),
+        [a, b] if b.name == *host => Ok((b.name.clone(), a.name.clone())),
+        [_, _] => Err(RunError::Scenario(format!("the merge host `{host}` is not one of the robots"))),
+        robots => Err(RunError::Scenario(format!("a run takes two robots, found {}", robots.len()))),
+    }
+}
+
 /// Runs a scenario end to end.
 pub fn run(scenario: &Scenario, mut opts: RunOptions) -> Result<RunOutput, RunError> {
     let wall = Instant::now();
+    let (host, other) = merge_pair(scenario)?;
     let config = SimConfig { dt: scenario.dt, ..SimConfig::default() };
     let mut sim = Sim::with_config(&scenario.world, scenario.seed, config)?;
     let truth = sim.true_map(scenario.truth_resolution)?;
@@ -197,8 +211,8 @@ pub fn run(scenario: &Scenario, mut opts: RunOptions) -> Result<RunOutput, RunEr
             observed: vec![false; truth.width() * truth.height()],
         });
     }
+    let algorithms = opts.algorithms.clone().unwrap_or_else(|| scenario.merge.algorithms.clone());
     if let Some(v) = opts.viz.as_deref_mut() {
-        let algorithms = opts.algorithms.clone().unwrap_or_else(|| scenario.merge.algorithms.clone());
         viz_begin(v, &sim, &truth, &agents, &algorithms);
     }
     let dt = scenario.dt;
@@ -328,15 +342,12 @@ pub fn run(scenario: &Scenario, mut opts: RunOptions) -> Result<RunOutput, RunEr
         frames.insert(a.setup.name.clone(), t0);
         maps.insert(a.setup.name.clone(), map);
     }
-    let host = scenario.merge.host.clone();
-    let other = scenario.robots.iter().map(|r| r.name.clone()).find(|n| *n != host).expect("two robots");
     let true_t = frames[&host].inv_mul(&frames[&other]);
     let end_t = end_frames[&host].inv_mul(&end_frames[&other]);
-    let algorithms = opts.algorithms.clone().unwrap_or_else(|| scenario.merge.algorithms.clone());
     let mut merges = Vec::new();
     let mut results = Vec::new();
-    for name in &algorithms {
-        let merger = merger_for(name, scenario)?;
+    for &algorithm in &algorithms {
+        let merger = merger_for(algorithm, scenario);
         let out = merge(merger.as_ref(), &maps[&host], &maps[&other], &MergeParams::default());
         let err = out.report.transform.map(|t| transform_error(&t.to_pose(), &true_t));
         let err_at_end = out.report.transform.map(|t| transform_error(&t.to_pose(), &end_t));
@@ -345,7 +356,7 @@ pub fn run(scenario: &Scenario, mut opts: RunOptions) -> Result<RunOutput, RunEr
                 r.to_degrees() <= scenario.success.rotation_deg && t <= scenario.success.translation_m
             });
         results.push(MergeResult {
-            algorithm: name.clone(),
+            algorithm: algorithm.to_string(),
             accepted: out.report.accepted,
             success,
             rotation_error_deg: err.map(|e| e.0.to_degrees()),
@@ -453,11 +464,12 @@ fn viz_walls(sim: &Sim) -> Vec<Vec<Point2<f64>>> {
 }
 
 /// Static content and layout.
-fn viz_begin(v: &mut RunRecorder, sim: &Sim, truth: &OccupancyGrid, agents: &[Agent], algorithms: &[String]) {
+fn viz_begin(v: &mut RunRecorder, sim: &Sim, truth: &OccupancyGrid, agents: &[Agent], algorithms: &[Algorithm]) {
     let robots: Vec<RobotInfo> =
         agents.iter().map(|a| RobotInfo { name: a.setup.name.clone(), start: a.setup.start }).collect();
+    let algorithms: Vec<String> = algorithms.iter().map(Algorithm::to_string).collect();
     v.set_time(0, sim.time());
-    v.begin(&viz_walls(sim), truth, &robots, algorithms);
+    v.begin(&viz_walls(sim), truth, &robots, &algorithms);
 }
 
 /// A step: slip and contacts, and this step's scans with the true and odometry poses they were taken at.
@@ -500,4 +512,41 @@ fn viz_slam(v: &mut RunRecorder, agents: &[Agent]) -> Result<(), RunError> {
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn two_rooms() -> Scenario {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenarios/paper_two_rooms.toml");
+        Scenario::from_file(&path).unwrap()
+    }
+
+    #[test]
+    fn a_scenario_changed_in_code_is_refused_before_the_run_not_by_a_panic() {
+        let refused = |s: &Scenario| match run(s, RunOptions::default()) {
+            Err(RunError::Scenario(m)) => m,
+            Err(e) => panic!("unexpected error {e}"),
+            Ok(_) => panic!("the run went ahead"),
+        };
+        let mut s = two_rooms();
+        s.robots.pop();
+        assert_eq!(refused(&s), "a run takes two robots, found 1");
+        let mut s = two_rooms();
+        s.merge.host = "nobody".into();
+        assert_eq!(refused(&s), "the merge host `nobody` is not one of the robots");
+        let mut s = two_rooms();
+        s.robots[1].name = s.robots[0].name.clone();
+        assert!(refused(&s).contains("share the name"));
+    }
+
+    #[test]
+    fn the_host_comes_first_in_the_merge_pair() {
+        let mut s = two_rooms();
+        let (a, b) = (s.robots[0].name.clone(), s.robots[1].name.clone());
+        assert_eq!(merge_pair(&s).unwrap(), (a.clone(), b.clone()));
+        s.merge.host = b.clone();
+        assert_eq!(merge_pair(&s).unwrap(), (b, a));
+    }
 }

@@ -4,7 +4,7 @@
 //! Every error names the file, the line and the field at fault.
 
 use mrslam_core::{Pose2, pose};
-use mrslam_merge::{MapEncoding, Model};
+use mrslam_merge::{Algorithm, MapEncoding, Model};
 use mrslam_sim::{EncoderParams, LidarModel, RobotModel, SlipParams, World, WorldSpec};
 use mrslam_slam::SlamParams;
 use nalgebra::Point2;
@@ -79,7 +79,7 @@ pub struct MergeSetup {
     /// When to merge.
     pub when: MergeWhen,
     /// Algorithms to run on the same maps, in order.
-    pub algorithms: Vec<String>,
+    pub algorithms: Vec<Algorithm>,
     /// Transform model of the SIFT merger.
     pub model: Model,
     /// Lowe's ratio.
@@ -110,6 +110,8 @@ pub struct Success {
 pub struct Scenario {
     /// Name (default: the file stem).
     pub name: String,
+    /// The file's `description`: free text for people choosing a scenario; the run does not use it.
+    pub description: Option<String>,
     /// The scenario file.
     pub path: PathBuf,
     /// The world file.
@@ -136,7 +138,6 @@ pub struct Scenario {
 #[serde(deny_unknown_fields)]
 struct ScenarioFile {
     name: Option<String>,
-    #[allow(dead_code)]
     description: Option<String>,
     world: String,
     seed: u64,
@@ -259,9 +260,6 @@ struct SuccessFile {
     translation_m: Option<f64>,
 }
 
-/// Merge algorithms a scenario may name.
-pub const ALGORITHMS: &[&str] = &["sift", "rmap"];
-
 /// The 1-based line of the first line of `text` containing `needle` (0 when absent).
 fn line_of(text: &str, needle: &str) -> usize {
     text.lines().position(|l| l.contains(needle)).map_or(0, |i| i + 1)
@@ -356,6 +354,7 @@ impl Scenario {
             .unwrap_or_else(|| path.file_stem().map_or("scenario".into(), |s| s.to_string_lossy().into_owned()));
         Ok(Scenario {
             name,
+            description: file.description.clone(),
             path: path.to_path_buf(),
             world_path,
             world,
@@ -542,16 +541,7 @@ fn resolve_lidar(cx: &Ctx, field: &str, r: &LidarRef) -> Result<LidarModel, Scen
 
 fn resolve_slam(cx: &Ctx, field: &str, s: &SlamFile, lidar: &LidarModel) -> Result<SlamParams, ScenarioError> {
     let mut p = match s.preset.as_deref() {
-        Some("hokuyo") => SlamParams::hokuyo(),
-        Some("rplidar") => SlamParams::rplidar(),
-        Some("gmapping") => SlamParams::default(),
-        Some(other) => {
-            return Err(cx.err(
-                field,
-                other,
-                format!("unknown SLAM preset `{other}` (expected hokuyo, rplidar or gmapping)"),
-            ));
-        }
+        Some(name) => name.parse::<mrslam_slam::Preset>().map_err(|e| cx.err(field, name, e))?.params(),
         // Without a preset, the one matching the lidar's reach.
         None if lidar.range_max <= 4.5 => SlamParams::hokuyo(),
         None => SlamParams::rplidar(),
@@ -605,16 +595,13 @@ fn resolve_merge(cx: &Ctx, m: &MergeFile, robots: &[RobotSetup], duration: f64) 
             ));
         }
     }
-    let algorithms = m.algorithms.clone().unwrap_or_else(|| vec!["sift".to_string()]);
-    for a in &algorithms {
-        if !ALGORITHMS.contains(&a.as_str()) {
-            return Err(cx.err(
-                "merge.algorithms",
-                a,
-                format!("unknown algorithm `{a}` (expected one of {})", ALGORITHMS.join(", ")),
-            ));
-        }
-    }
+    let algorithms = match &m.algorithms {
+        None => vec![Algorithm::Sift],
+        Some(names) => names
+            .iter()
+            .map(|a| a.parse::<Algorithm>().map_err(|e| cx.err("merge.algorithms", a, e.to_string())))
+            .collect::<Result<_, _>>()?,
+    };
     let model = match &m.model {
         None => Model::Rigid,
         Some(s) => s.parse().map_err(|e: String| cx.err("merge.model", s, e))?,
@@ -644,4 +631,35 @@ fn resolve_merge(cx: &Ctx, m: &MergeFile, robots: &[RobotSetup], duration: f64) 
     let hypotheses = in_range("merge.hypotheses", m.hypotheses, 1, 16, 1)?;
     let wall_dilation = in_range("merge.wall_dilation", m.wall_dilation, 0, 4, 0)?;
     Ok(MergeSetup { when, algorithms, model, ratio, encoding, candidates, hypotheses, wall_dilation, host })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `paper_two_rooms.toml` with `edit` applied to its text, resolved as if it lay beside the original.
+    fn two_rooms(edit: impl Fn(String) -> String) -> Result<Scenario, ScenarioError> {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenarios/paper_two_rooms.toml");
+        let text = std::fs::read_to_string(&path).unwrap();
+        Scenario::parse(&edit(text), &path)
+    }
+
+    #[test]
+    fn algorithms_are_read_by_name_and_default_to_sift() {
+        let s = two_rooms(|t| t).unwrap();
+        assert_eq!(s.merge.algorithms, [Algorithm::Sift, Algorithm::Rmap]);
+        let s = two_rooms(|t| t.replace("algorithms = [\"sift\", \"rmap\"]\n", "")).unwrap();
+        assert_eq!(s.merge.algorithms, [Algorithm::Sift]);
+        let e = two_rooms(|t| t.replace("[\"sift\", \"rmap\"]", "[\"sift\", \"magic\"]")).unwrap_err();
+        assert_eq!((e.line, e.field.as_str()), (12, "merge.algorithms"));
+        assert_eq!(e.message, "unknown algorithm `magic` (expected one of sift, rmap)");
+    }
+
+    #[test]
+    fn the_description_is_kept_and_may_be_left_out() {
+        let s = two_rooms(|t| t).unwrap();
+        assert_eq!(s.description.as_deref(), Some("two heterogeneous robots map two rooms and merge by the door"));
+        let s = two_rooms(|t| t.lines().filter(|l| !l.starts_with("description")).collect::<Vec<_>>().join("\n"));
+        assert_eq!(s.unwrap().description, None);
+    }
 }

@@ -354,7 +354,7 @@ impl RmapMerger {
 
 impl Merger for RmapMerger {
     fn name(&self) -> &'static str {
-        "rmap"
+        crate::Algorithm::Rmap.name()
     }
 
     fn align(&self, a: &OccupancyGrid, b: &OccupancyGrid) -> Result<Alignment, Box<NoAlignment>> {

@@ -1,2 +1,3 @@
 //! Helpers shared by the integration tests.
+#[path = "../../src/synth.rs"]
 pub mod synth;

@@ -1,36 +1,59 @@
-//! The merge algorithms a study can compare, built for one trial.
+//! The merge algorithms a study compares, built for one trial.
 
-use mrslam_merge::{Merger, RmapMerger, RmapParams, SiftMerger, SiftMergerParams};
+use mrslam_merge::{Algorithm, Merger, RmapMerger, RmapParams, SiftMerger, SiftMergerParams};
 
-/// Algorithm names a study accepts.
-pub const STUDY_ALGORITHMS: &[&str] = &["sift", "rmap"];
-
-/// The merger called `name` with default parameters, its random draws seeded by `seed`; None when unknown.
-pub fn study_merger(name: &str, seed: u64) -> Option<Box<dyn Merger>> {
-    match name {
-        "sift" => {
+/// `algorithm`'s merger with default parameters for a map-level trial seeded `seed`.
+///
+/// Only the SIFT merger's draws (its RANSAC) follow `seed`; the R-map merger's orientation draws keep their
+/// default seed ([`RmapParams::default`], 0) in every trial, as the published studies were computed. A
+/// simulated run ([`crate::runner::merger_for`]) seeds both with the scenario's seed.
+pub fn study_merger(algorithm: Algorithm, seed: u64) -> Box<dyn Merger> {
+    match algorithm {
+        Algorithm::Sift => {
             let mut p = SiftMergerParams::default();
             p.ransac.seed = seed;
-            Some(Box::new(SiftMerger::new(p)))
+            Box::new(SiftMerger::new(p))
         }
-        "rmap" => Some(Box::new(RmapMerger::new(RmapParams::default()))),
-        _ => None,
+        Algorithm::Rmap => Box::new(RmapMerger::new(RmapParams::default())),
     }
 }
 
-/// Checks a list of algorithm names: known, not repeated, not empty.
-pub fn check_algorithms(names: &[String]) -> Result<(), super::StudyError> {
+/// Checks a list of algorithms: not empty, none repeated.
+pub fn check_algorithms(algorithms: &[Algorithm]) -> Result<(), super::StudyError> {
     let bad = |m: String| Err(super::StudyError::Invalid(m));
-    if names.is_empty() {
+    if algorithms.is_empty() {
         return bad("no algorithms given".into());
     }
-    for (i, n) in names.iter().enumerate() {
-        if !STUDY_ALGORITHMS.contains(&n.as_str()) {
-            return bad(format!("unknown algorithm `{n}` (expected one of {})", STUDY_ALGORITHMS.join(", ")));
-        }
-        if names[..i].contains(n) {
-            return bad(format!("algorithm `{n}` given twice"));
+    for (i, a) in algorithms.iter().enumerate() {
+        if algorithms[..i].contains(a) {
+            return bad(format!("algorithm `{a}` given twice"));
         }
     }
     Ok(())
+}
+
+/// Reads a list of algorithm names, then checks it as [`check_algorithms`] does; an unknown name's error
+/// lists the valid ones.
+pub fn parse_algorithms<S: AsRef<str>>(names: &[S]) -> Result<Vec<Algorithm>, super::StudyError> {
+    let algorithms = names
+        .iter()
+        .map(|n| n.as_ref().parse::<Algorithm>())
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|e| super::StudyError::Invalid(e.to_string()))?;
+    check_algorithms(&algorithms)?;
+    Ok(algorithms)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_are_read_and_checked() {
+        assert_eq!(parse_algorithms(&["sift", "rmap"]).unwrap(), [Algorithm::Sift, Algorithm::Rmap]);
+        let err = |names: &[&str]| parse_algorithms(names).unwrap_err().to_string();
+        assert_eq!(err(&["sift", "magic"]), "unknown algorithm `magic` (expected one of sift, rmap)");
+        assert_eq!(err(&["rmap", "rmap"]), "algorithm `rmap` given twice");
+        assert_eq!(err(&[]), "no algorithms given");
+    }
 }

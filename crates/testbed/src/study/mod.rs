@@ -66,7 +66,7 @@ impl StudyError {
     }
 }
 
-pub use algorithms::{STUDY_ALGORITHMS, study_merger};
+pub use algorithms::{check_algorithms, parse_algorithms, study_merger};
 pub use overlap::{MapSource, OverlapStudy, run_overlap_study};
 pub use range::parse_range;
 pub use results::{TrialRow, collect, read_results, write_results};

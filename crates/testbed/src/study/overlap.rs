@@ -10,7 +10,7 @@ use crate::eval::transform_error;
 use mrslam_core::OccupancyGrid;
 use mrslam_merge::floorplan::{FloorplanParams, generate};
 use mrslam_merge::pairs::{PairSpec, cut_pair};
-use mrslam_merge::{MergeParams, merge};
+use mrslam_merge::{Algorithm, MergeParams, merge};
 use rayon::prelude::*;
 
 /// Where a study's ground-truth maps come from.
@@ -37,7 +37,7 @@ pub struct OverlapStudy {
     /// Trials per overlap.
     pub trials: usize,
     /// Algorithms, in the order rows are written.
-    pub algorithms: Vec<String>,
+    pub algorithms: Vec<Algorithm>,
     /// Study seed.
     pub seed: u64,
     /// Success: rotation error at most this, degrees.
@@ -129,19 +129,19 @@ fn run_trial(study: &OverlapStudy, map: &OccupancyGrid, t: &TrialSpec) -> Vec<Tr
     study
         .algorithms
         .iter()
-        .filter_map(|name| {
-            let merger = study_merger(name, t.seed)?;
+        .map(|&algorithm| {
+            let merger = study_merger(algorithm, t.seed);
             let out = merge(merger.as_ref(), &pair.a, &pair.b, &MergeParams::default());
             let err = out.report.transform.map(|x| transform_error(&x.to_pose(), &pair.t_a_b));
             let accepted = out.report.accepted;
             let success = accepted
                 && err.is_some_and(|(r, d)| r.to_degrees() <= study.max_rotation_deg && d <= max_translation_m);
-            Some(TrialRow {
+            TrialRow {
                 trial: t.trial,
                 overlap_target: Some(t.overlap_target),
                 overlap: pair.overlap,
                 seed: t.seed,
-                algorithm: name.clone(),
+                algorithm: algorithm.to_string(),
                 accepted,
                 success,
                 false_merge: accepted && !success,
@@ -150,7 +150,7 @@ fn run_trial(study: &OverlapStudy, map: &OccupancyGrid, t: &TrialSpec) -> Vec<Tr
                 time_ms: out.report.time_ms,
                 rotation_error_at_end_deg: None,
                 translation_error_at_end_m: None,
-            })
+            }
         })
         .collect()
 }
@@ -167,7 +167,7 @@ mod tests {
             },
             overlaps: vec![0.3, 0.6],
             trials: 2,
-            algorithms: vec!["sift".into()],
+            algorithms: vec![Algorithm::Sift],
             seed: 3,
             max_rotation_deg: 2.0,
             max_translation_cells: 2.0,
@@ -185,7 +185,7 @@ mod tests {
             let s = OverlapStudy { shard: Shard::new(k, 2).unwrap(), ..small() };
             parts.extend(run_overlap_study(&s, &|| {}).unwrap());
         }
-        sort_rows(&mut parts, &["sift".to_string()]);
+        sort_rows(&mut parts, &[Algorithm::Sift]);
         let strip = |r: &TrialRow| TrialRow { time_ms: 0.0, ..r.clone() };
         assert_eq!(whole.iter().map(strip).collect::<Vec<_>>(), parts.iter().map(strip).collect::<Vec<_>>());
         for r in &whole {
@@ -197,7 +197,10 @@ mod tests {
     #[test]
     fn bad_parameters_are_refused() {
         assert!(run_overlap_study(&OverlapStudy { trials: 0, ..small() }, &|| {}).is_err());
-        let e = run_overlap_study(&OverlapStudy { algorithms: vec!["nope".into()], ..small() }, &|| {});
-        assert!(e.unwrap_err().to_string().contains("unknown algorithm"));
+        let e = run_overlap_study(&OverlapStudy { algorithms: vec![], ..small() }, &|| {});
+        assert!(e.unwrap_err().to_string().contains("no algorithms"));
+        let twice = vec![Algorithm::Rmap, Algorithm::Rmap];
+        let e = run_overlap_study(&OverlapStudy { algorithms: twice, ..small() }, &|| {});
+        assert!(e.unwrap_err().to_string().contains("given twice"));
     }
 }

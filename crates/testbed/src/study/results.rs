@@ -115,8 +115,8 @@ impl TrialRow {
 }
 
 /// Sorts rows by trial, then by the order the algorithms were given in (`order`; others by name after).
-pub fn sort_rows(rows: &mut [TrialRow], order: &[String]) {
-    let rank = |a: &str| order.iter().position(|o| o == a).unwrap_or(usize::MAX);
+pub fn sort_rows<S: AsRef<str>>(rows: &mut [TrialRow], order: &[S]) {
+    let rank = |a: &str| order.iter().position(|o| o.as_ref() == a).unwrap_or(usize::MAX);
     rows.sort_by(|x, y| {
         x.trial.cmp(&y.trial).then(rank(&x.algorithm).cmp(&rank(&y.algorithm))).then(x.algorithm.cmp(&y.algorithm))
     });

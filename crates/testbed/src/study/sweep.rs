@@ -15,14 +15,13 @@
 //! observed overlap (Jaccard of the true cells each robot's beams crossed), not an assumed one.
 
 use super::StudyError;
-use super::algorithms::{check_algorithms, study_merger};
+use super::algorithms::parse_algorithms;
 use super::results::{TrialRow, sort_rows};
 use super::shard::Shard;
-use crate::eval::transform_error;
-use crate::runner::{RunOptions, merger_for, run};
+use crate::runner::{RunOptions, run};
 use crate::scenario::Scenario;
-use mrslam_core::{Pose2, pose};
-use mrslam_merge::{MergeParams, merge};
+use mrslam_core::pose;
+use mrslam_merge::Algorithm;
 use mrslam_sim::World;
 use rayon::prelude::*;
 use serde::Deserialize;
@@ -79,7 +78,7 @@ pub struct Sweep {
     /// The base scenario.
     pub scenario: Scenario,
     /// Algorithms, in row order.
-    pub algorithms: Vec<String>,
+    pub algorithms: Vec<Algorithm>,
     /// Seeds each variant runs with.
     pub seeds: Vec<u64>,
     /// The varied parameters (stepping together).
@@ -102,8 +101,11 @@ impl Sweep {
         let dir = path.parent().unwrap_or(Path::new("."));
         let scenario = Scenario::from_file(&dir.join(&file.scenario))
             .map_err(|e| at(line_of(&text, "scenario"), format!("scenario: {e}")))?;
-        let algorithms = file.algorithms.clone().unwrap_or_else(|| scenario.merge.algorithms.clone());
-        check_algorithms(&algorithms).map_err(|e| at(line_of(&text, "algorithms"), format!("algorithms: {e}")))?;
+        let algorithms = match &file.algorithms {
+            Some(names) => parse_algorithms(names),
+            None => super::check_algorithms(&scenario.merge.algorithms).map(|()| scenario.merge.algorithms.clone()),
+        }
+        .map_err(|e| at(line_of(&text, "algorithms"), format!("algorithms: {e}")))?;
         if file.seeds.is_empty() {
             return Err(at(line_of(&text, "seeds"), "seeds: give at least one seed".into()));
         }
@@ -241,56 +243,27 @@ pub fn run_sweep(sweep: &Sweep, shard: Shard, progress: &(dyn Fn() + Sync)) -> R
 }
 
 fn run_trial(sweep: &Sweep, scenario: &Scenario, trial: usize) -> Result<Vec<TrialRow>, StudyError> {
-    let fail = |m: String| StudyError::Trial { trial, message: m };
-    // The runner merges with the algorithms it knows (and so finds the true transform); the others run here
-    // on the same maps.
-    let mut by_runner: Vec<String> =
-        sweep.algorithms.iter().filter(|a| merger_for(a, scenario).is_ok()).cloned().collect();
-    if by_runner.is_empty() {
-        by_runner.push("sift".into());
-    }
-    let out = run(scenario, RunOptions { algorithms: Some(by_runner), ..RunOptions::default() })
-        .map_err(|e| fail(format!("seed {}: {e}", scenario.seed)))?;
+    // The runner merges with every algorithm of the sweep, in its order, and scores each against the truth.
+    let out = run(scenario, RunOptions { algorithms: Some(sweep.algorithms.clone()), ..RunOptions::default() })
+        .map_err(|e| StudyError::Trial { trial, message: format!("seed {}: {e}", scenario.seed) })?;
     let report = &out.report;
-    let first = report.merges.first().ok_or_else(|| fail("no merge".into()))?;
-    let (true_t, end_t) = (first.true_transform.to_pose(), first.true_transform_at_end.to_pose());
-    let [host, other] = &report.merge_pair;
-    let ok = |r: f64, t: f64| r <= scenario.success.rotation_deg && t <= scenario.success.translation_m;
-    let mut rows = Vec::new();
-    for name in &sweep.algorithms {
-        let row =
-            |accepted: bool, success: bool, err: Option<(f64, f64)>, at_end: Option<(f64, f64)>, time_ms| TrialRow {
-                trial,
-                overlap_target: None,
-                overlap: report.observed_overlap,
-                seed: scenario.seed,
-                algorithm: name.clone(),
-                accepted,
-                success,
-                false_merge: accepted && !success,
-                rotation_error_deg: err.map(|e| e.0),
-                translation_error_m: err.map(|e| e.1),
-                time_ms,
-                rotation_error_at_end_deg: at_end.map(|e| e.0),
-                translation_error_at_end_m: at_end.map(|e| e.1),
-            };
-        if let Some(m) = report.merges.iter().find(|m| &m.algorithm == name) {
-            let err = m.rotation_error_deg.zip(m.translation_error_m);
-            let at_end = m.rotation_error_at_end_deg.zip(m.translation_error_at_end_m);
-            rows.push(row(m.accepted, m.success, err, at_end, m.time_ms));
-        } else {
-            let merger = study_merger(name, scenario.seed).ok_or_else(|| fail(format!("unknown algorithm {name}")))?;
-            let o = merge(merger.as_ref(), &out.maps[host], &out.maps[other], &MergeParams::default());
-            let error_to = |truth: &Pose2| {
-                o.report.transform.map(|x| {
-                    let (r, t) = transform_error(&x.to_pose(), truth);
-                    (r.to_degrees(), t)
-                })
-            };
-            let (err, at_end) = (error_to(&true_t), error_to(&end_t));
-            let success = o.report.accepted && err.is_some_and(|(r, t)| ok(r, t));
-            rows.push(row(o.report.accepted, success, err, at_end, o.report.time_ms));
-        }
-    }
-    Ok(rows)
+    Ok(report
+        .merges
+        .iter()
+        .map(|m| TrialRow {
+            trial,
+            overlap_target: None,
+            overlap: report.observed_overlap,
+            seed: scenario.seed,
+            algorithm: m.algorithm.clone(),
+            accepted: m.accepted,
+            success: m.success,
+            false_merge: m.accepted && !m.success,
+            rotation_error_deg: m.rotation_error_deg,
+            translation_error_m: m.translation_error_m,
+            time_ms: m.time_ms,
+            rotation_error_at_end_deg: m.rotation_error_at_end_deg,
+            translation_error_at_end_m: m.translation_error_at_end_m,
+        })
+        .collect())
 }

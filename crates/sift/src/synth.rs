@@ -1,4 +1,6 @@
-//! Deterministic synthetic test images (shared by tests, examples and benches through `#[path]`).
+//! Deterministic synthetic test images and the tests' random numbers: a `#[cfg(test)]` module of the library
+//! for its unit tests; the integration tests (`tests/common`), the bench and the `gen_images` example include
+//! this same file, so every test draws the same sequences.
 #![allow(dead_code)]
 
 /// A tiny 64-bit LCG (Knuth's MMIX constants); enough for test images, no dependency.
