@@ -203,6 +203,19 @@ fn arrival_order_lines(run: &SyntheticRun) -> Vec<String> {
     timed.into_iter().map(|(_, l)| l).collect()
 }
 
+/// `mrslam slam LOG --preset hokuyo --relations REL --summary ...` plus `extra`, writing beside the log; returns
+/// what it printed and the summary.
+fn slam_scored(log: &Path, rel: &Path, extra: &[&str]) -> (String, serde_json::Value) {
+    let (map, summary) = (log.with_extension("yaml"), log.with_extension("json"));
+    let mut args = vec!["slam", log.to_str().unwrap(), "-o", map.to_str().unwrap(), "--preset", "hokuyo"];
+    args.extend(["--relations", rel.to_str().unwrap(), "--summary", summary.to_str().unwrap(), "--quiet"]);
+    args.extend_from_slice(extra);
+    let o = mrslam(&args);
+    assert!(o.status.success(), "{args:?}: {}", text(&o.stderr));
+    let s = serde_json::from_str(&std::fs::read_to_string(&summary).unwrap()).unwrap();
+    (text(&o.stdout), s)
+}
+
 /// Data lines (not comments) of a trajectory file.
 fn poses_of(path: &Path) -> Vec<String> {
     std::fs::read_to_string(path).unwrap().lines().filter(|l| !l.starts_with('#')).map(str::to_string).collect()
@@ -244,32 +257,11 @@ fn a_log_in_arrival_order_maps_as_its_sorted_twin_with_a_pose_for_every_scan() {
         } else {
             assert!(info.contains("stamps in order"), "{info}");
         }
-        let (map, traj, summary) = (
-            dir.path().join(format!("{name}.yaml")),
-            dir.path().join(format!("{name}.txt")),
-            dir.path().join(format!("{name}.json")),
-        );
-        let o = mrslam(&[
-            "slam",
-            log.to_str().unwrap(),
-            "-o",
-            map.to_str().unwrap(),
-            "--trajectory",
-            traj.to_str().unwrap(),
-            "--preset",
-            "hokuyo",
-            "--relations",
-            rel.to_str().unwrap(),
-            "--summary",
-            summary.to_str().unwrap(),
-            "--quiet",
-        ]);
-        let out = text(&o.stdout);
-        assert!(o.status.success(), "{}", text(&o.stderr));
+        let traj = dir.path().join(format!("{name}.txt"));
+        let (out, s) = slam_scored(&log, &rel, &["--trajectory", traj.to_str().unwrap()]);
         assert!(out.contains("relations: 230 used, 0 missing"), "{out}");
         let header = std::fs::read_to_string(&traj).unwrap();
         assert!(header.starts_with("# mrslam slam ") && header.contains("one pose per scan (240 scans)"), "{header}");
-        let s: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&summary).unwrap()).unwrap();
         assert_eq!((s["scans"].as_u64(), s["metric"]["used"].as_u64()), (Some(240), Some(230)), "{s}");
         assert!(s["processed"].as_u64().unwrap() < 100, "updates every 0.25 m: {s}");
         assert!(
@@ -316,25 +308,8 @@ fn a_robotlaser1_log_maps_end_to_end() {
     let log = write_log(dir.path(), "robot.clf", &lines);
     let rel = dir.path().join("robot.relations");
     std::fs::write(&rel, true_relations(&run, 20)).unwrap();
-    let map = dir.path().join("robot.yaml");
-    let json = dir.path().join("summary.json");
-    let o = mrslam(&[
-        "slam",
-        log.to_str().unwrap(),
-        "-o",
-        map.to_str().unwrap(),
-        "--preset",
-        "hokuyo",
-        "--relations",
-        rel.to_str().unwrap(),
-        "--summary",
-        json.to_str().unwrap(),
-        "--quiet",
-    ]);
-    let out = text(&o.stdout);
-    assert!(o.status.success(), "{}", text(&o.stderr));
+    let (out, s) = slam_scored(&log, &rel, &[]);
     assert!(out.contains("the scan lines' own odometry fields (240 scans)"), "{out}");
-    let s: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
     let m = &s["metric"];
     assert_eq!(m["used"].as_u64(), Some(220), "{s}");
     // Odometry drifts 3 % of 1 m and 0.01 rad per metre on these relations: SLAM must be well under that.
