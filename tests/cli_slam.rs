@@ -165,6 +165,32 @@ fn bad_logs_and_parameters_are_refused_and_write_nothing() {
     broken[5] = "FLASER 667 1.0 2.0".into();
     let broken = write_log(dir.path(), "broken.clf", &broken);
     refused(&broken, &[], &["broken.clf:6", "FLASER"]);
+    // A kidnapped robot: the odometry of the 20th scan (line 22) jumps 50 m. Mapped, and said.
+    let mut kidnapped = lines.clone();
+    let fields: Vec<String> = kidnapped[21].split_whitespace().map(str::to_string).collect();
+    let n = fields.len();
+    let moved: Vec<String> = fields
+        .iter()
+        .enumerate()
+        .map(
+            |(i, f)| {
+                if i == n - 6 || i == n - 9 { format!("{:.6}", f.parse::<f64>().unwrap() + 50.0) } else { f.clone() }
+            },
+        )
+        .collect();
+    kidnapped[21] = moved.join(" ");
+    let kidnapped = write_log(dir.path(), "kidnapped.clf", &kidnapped);
+    let o = mrslam(&["slam", kidnapped.to_str().unwrap(), "-o", map.to_str().unwrap(), "--quiet"]);
+    let out = text(&o.stdout);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    assert!(
+        out.contains("warning: the odometry jumps 2 times")
+            && out.contains("largest 50.")
+            && out.contains("at line 22"),
+        "{out}"
+    );
+    std::fs::remove_file(&map).unwrap();
+    std::fs::remove_file(map.with_extension("pgm")).unwrap();
     let empty = write_log(dir.path(), "empty.clf", &lines[..2]);
     refused(&empty, &[], &["empty.clf", "no laser scans"]);
 }

@@ -131,6 +131,8 @@ pub fn run(args: SlamArgs) -> Result<ExitCode> {
         inject_drift(&mut odo, &drift, args.seed ^ 0x5eed_d21f_7000_0001);
     }
 
+    let jumps = odometry_jumps(&odo, &log.scans);
+
     let offset: Pose2 = log.scans[0].laser_offset;
     let mut filter = Rbpf::new(params, offset, args.seed).context("slam parameters")?;
     let bar = ProgressBar::new(log.scans.len() as u64);
@@ -191,6 +193,18 @@ pub fn run(args: SlamArgs) -> Result<ExitCode> {
     let peak = super::peak_memory_bytes();
     println!("log: {} ({:.1} s); {}", args.log.display(), duration, log.repairs.describe());
     println!("odometry: {}", log.repairs.describe_odometry());
+    if let Some(worst) = jumps.iter().max_by(|a, b| a.distance.total_cmp(&b.distance)) {
+        println!(
+            "warning: the odometry jumps {} times (faster than {MAX_SPEED} m/s or {MAX_TURN_RATE} rad/s between scans; \
+             largest {:.2} m and {:.2} rad in {:.3} s at line {}); the filter drew its particles through each jump \
+             with the motion model's noise, so the map around it may be wrong",
+            jumps.len(),
+            worst.distance,
+            worst.turn,
+            worst.seconds,
+            worst.line
+        );
+    }
     println!(
         "slam: {} scans: {} processed, {} skipped (not moved {}, empty {}), {} invalid beams ignored, {} resamples",
         c.readings,
@@ -251,9 +265,43 @@ pub fn run(args: SlamArgs) -> Result<ExitCode> {
                 "interpolated_odometry": r.interpolated_odometry,
                 "line_odometry": r.line_odometry,
             },
+            "odometry_jumps": jumps.len(),
             "metric": score.as_ref().map(|s| super::eval::to_json(s, args.tolerance, 10)),
         });
         super::eval::write_json(path, &summary)?;
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// Odometry faster than this between two scans is a jump (a kidnapped robot or a reset), m/s.
+const MAX_SPEED: f64 = 5.0;
+/// Odometry turning faster than this between two scans is a jump, rad/s.
+const MAX_TURN_RATE: f64 = 10.0;
+
+/// An odometry jump between two consecutive scans.
+struct OdometryJump {
+    /// Log line of the later scan.
+    line: usize,
+    /// Metres moved.
+    distance: f64,
+    /// Radians turned.
+    turn: f64,
+    /// Seconds between the scans.
+    seconds: f64,
+}
+
+/// The increments between consecutive scans' odometry that no robot drives: faster than [`MAX_SPEED`] or
+/// [`MAX_TURN_RATE`] (over at least 0.1 s, so that stamp jitter does not make a slow move look fast).
+fn odometry_jumps(odometry: &[Odometry], scans: &[mrslam_core::ScanRecord]) -> Vec<OdometryJump> {
+    let mut jumps = Vec::new();
+    for (k, w) in odometry.windows(2).enumerate() {
+        let step = w[0].pose.inv_mul(&w[1].pose);
+        let (distance, turn) = (step.translation.vector.norm(), step.rotation.angle().abs());
+        let seconds = w[1].stamp - w[0].stamp;
+        let span = seconds.max(0.1);
+        if distance > MAX_SPEED * span || turn > MAX_TURN_RATE * span {
+            jumps.push(OdometryJump { line: scans[k + 1].line, distance, turn, seconds });
+        }
+    }
+    jumps
 }
