@@ -82,10 +82,9 @@ pub struct SlamArgs {
 /// Runs `mrslam slam`.
 pub fn run(args: SlamArgs) -> Result<ExitCode> {
     let outputs = [Some(&args.output), args.trajectory.as_ref(), args.summary.as_ref()];
+    let inputs: Vec<&std::path::Path> = std::iter::once(args.log.as_path()).chain(args.relations.as_deref()).collect();
     for p in outputs.into_iter().flatten() {
         super::check_output(p)?;
-        let inputs: Vec<&std::path::Path> =
-            std::iter::once(args.log.as_path()).chain(args.relations.as_deref()).collect();
         super::check_not_input(p, &inputs)?;
     }
     if !(args.tolerance.is_finite() && args.tolerance >= 0.0) {

@@ -20,7 +20,7 @@
 //! ([`OdometrySource`]); every repair is counted ([`Repairs`]). A step back of more than
 //! [`ReadOptions::max_step_back`] is refused, naming the line.
 
-use crate::pose::{Pose2, pose};
+use crate::pose::{Pose2, interpolate, pose};
 use crate::scan::{LaserScan, Odometry};
 use std::collections::BTreeMap;
 use std::io::{BufRead, BufReader, Read};
@@ -413,7 +413,9 @@ impl CarmenLog {
                 }
                 let (a, b) = (&odometry[k], &odometry[k + 1]);
                 if a.stamp <= t && t <= b.stamp {
-                    s.odometry = Odometry { stamp: s.scan.stamp, pose: interpolate(a, b, t) };
+                    let span = b.stamp - a.stamp;
+                    let f = if span > 0.0 { (t - a.stamp) / span } else { 0.0 };
+                    s.odometry = Odometry { stamp: s.scan.stamp, pose: interpolate(&a.pose, &b.pose, f) };
                     interpolated += 1;
                 }
             }
@@ -449,16 +451,6 @@ fn repair_reversing(odometry: &mut [(Odometry, f64)]) -> usize {
         }
     }
     repaired
-}
-
-/// The pose between two odometry readings at stamp `t` (linear in x, y and heading, the short way round).
-fn interpolate(a: &Odometry, b: &Odometry, t: f64) -> Pose2 {
-    let span = b.stamp - a.stamp;
-    let f = if span > 0.0 { ((t - a.stamp) / span).clamp(0.0, 1.0) } else { 0.0 };
-    let (ax, ay, at) = crate::pose::pose_xyt(&a.pose);
-    let (bx, by, bt) = crate::pose::pose_xyt(&b.pose);
-    let dt = crate::pose::angle_diff(bt, at);
-    pose(ax + f * (bx - ax), ay + f * (by - ay), at + f * dt)
 }
 
 /// Parses the first `n` fields as finite numbers, naming the expected layout on failure.

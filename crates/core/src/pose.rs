@@ -47,6 +47,13 @@ pub fn angle_diff(a: f64, b: f64) -> f64 {
     normalize_angle(a - b)
 }
 
+/// The pose a fraction `s` of the way from `a` to `b`: linear in x and y, the short way round in heading.
+pub fn interpolate(a: &Pose2, b: &Pose2, s: f64) -> Pose2 {
+    let (ax, ay, at) = pose_xyt(a);
+    let (bx, by, bt) = pose_xyt(b);
+    pose(ax + s * (bx - ax), ay + s * (by - ay), at + s * angle_diff(bt, at))
+}
+
 /// Transforms a point by a pose.
 pub fn transform_point(p: &Pose2, x: f64, y: f64) -> Point2<f64> {
     p * Point2::new(x, y)

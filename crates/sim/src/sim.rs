@@ -14,7 +14,7 @@ use crate::lidar::LidarModel;
 use crate::slip::{SlipParams, SlipState};
 use crate::world::World;
 use crate::world_file::WorldSpec;
-use mrslam_core::pose::angle_diff;
+use mrslam_core::pose::interpolate;
 use mrslam_core::{LaserScan, Odometry, Pose2, pose, pose_xyt};
 use nalgebra::{Point2, Vector2};
 use rand::SeedableRng;
@@ -133,13 +133,6 @@ fn to_glam(p: &Pose2) -> rp::Pose {
 
 fn from_glam(p: &rp::Pose) -> Pose2 {
     pose(p.translation.x as f64, p.translation.y as f64, p.rotation.angle() as f64)
-}
-
-/// Pose a fraction `s` of the way from `a` to `b` (linear in x, y; shortest way in heading).
-fn interpolate(a: &Pose2, b: &Pose2, s: f64) -> Pose2 {
-    let (ax, ay, at) = pose_xyt(a);
-    let (bx, by, bt) = pose_xyt(b);
-    pose(ax + s * (bx - ax), ay + s * (by - ay), at + s * angle_diff(bt, at))
 }
 
 fn obstacle_collider(o: &Obstacle) -> rp::ColliderBuilder {

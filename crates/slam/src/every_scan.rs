@@ -9,7 +9,7 @@
 //! odometry from it.
 
 use mrslam_core::Pose2;
-use mrslam_core::pose::{angle_diff, pose, pose_xyt};
+use mrslam_core::pose::interpolate;
 
 /// Poses for every scan, given each scan's stamp and odometry and the filter's poses at the processed
 /// scans as (index into the scans, pose), in increasing index order.
@@ -38,7 +38,7 @@ pub fn poses_at_every_scan(stamps: &[f64], odometry: &[Pose2], processed: &[(usi
             (Some(before), Some(after)) => {
                 let span = stamps[after.0] - stamps[before.0];
                 let f = if span > 0.0 { ((stamps[i] - stamps[before.0]) / span).clamp(0.0, 1.0) } else { 0.5 };
-                blend(&carried(i, before), &carried(i, after), f)
+                interpolate(&carried(i, before), &carried(i, after), f)
             }
             (None, None) => return None,
         };
@@ -47,16 +47,10 @@ pub fn poses_at_every_scan(stamps: &[f64], odometry: &[Pose2], processed: &[(usi
     Some(out)
 }
 
-/// `a` moved towards `b` by the fraction `f` (linear in x, y and heading, the short way round).
-fn blend(a: &Pose2, b: &Pose2, f: f64) -> Pose2 {
-    let (ax, ay, at) = pose_xyt(a);
-    let (bx, by, bt) = pose_xyt(b);
-    pose(ax + f * (bx - ax), ay + f * (by - ay), at + f * angle_diff(bt, at))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use mrslam_core::pose::{pose, pose_xyt};
 
     fn xyt(p: &Pose2) -> (f64, f64, f64) {
         pose_xyt(p)
