@@ -43,8 +43,9 @@ pub struct SlamArgs {
     /// How to read the log.
     #[command(flatten)]
     pub read: super::log::ReadArgs,
-    /// Parameter preset: gmapping, hokuyo or rplidar.
-    #[arg(long, default_value_t = Preset::Gmapping)]
+    /// Parameter preset: matched (GMapping's filter on scan-matched odometry), gmapping (the reference),
+    /// hokuyo or rplidar (the simulated robots').
+    #[arg(long, default_value_t = Preset::Matched)]
     pub preset: Preset,
     /// Number of particles.
     #[arg(long)]
@@ -144,8 +145,11 @@ pub fn run(args: SlamArgs) -> Result<ExitCode> {
     );
     let start = std::time::Instant::now();
     let mut processed: Vec<usize> = Vec::new();
+    // The odometry as the filter used it (scan-matched when `scan_odometry` is on), to place skipped scans.
+    let mut odometry: Vec<Pose2> = Vec::with_capacity(log.scans.len());
     for (i, (rec, o)) in log.scans.iter().zip(&odo).enumerate() {
         let out = filter.process(o, &rec.scan).with_context(|| format!("{}:{}", args.log.display(), rec.line))?;
+        odometry.push(filter.odometry_pose().unwrap_or(o.pose));
         if let Some(neff) = out.neff() {
             bar.set_message(format!("Neff {neff:.1}"));
         }
@@ -165,7 +169,6 @@ pub fn run(args: SlamArgs) -> Result<ExitCode> {
         bail!("internal: {} trajectory nodes for {} processed scans", keyframes.len(), processed.len());
     }
     let stamps: Vec<f64> = log.scans.iter().map(|r| r.scan.stamp).collect();
-    let odometry: Vec<Pose2> = odo.iter().map(|o| o.pose).collect();
     let anchors: Vec<(usize, Pose2)> = processed.iter().copied().zip(keyframes.iter().map(|k| k.1)).collect();
     let poses =
         poses_at_every_scan(&stamps, &odometry, &anchors).context("the filter processed no scan: no trajectory")?;
@@ -175,11 +178,12 @@ pub fn run(args: SlamArgs) -> Result<ExitCode> {
         let header = format!(
             "mrslam slam {}: one pose per scan ({} scans), `stamp x y theta`, the best particle's robot pose in \
              the map frame.\n{} scans were processed by the filter and carry its pose; every other scan is placed \
-             by the odometry from the processed scan before it and back from the processed scan after it, blended \
+             by the {} from the processed scan before it and back from the processed scan after it, blended \
              by time (before the first / after the last processed scan: odometry from it).",
             args.log.display(),
             trajectory.len(),
-            processed.len()
+            processed.len(),
+            if filter.params().scan_odometry { "scan-matched odometry" } else { "odometry" }
         );
         write_file_atomic(path, relations::format_trajectory(&header, &trajectory).as_bytes())?;
     }
@@ -221,6 +225,10 @@ pub fn run(args: SlamArgs) -> Result<ExitCode> {
         filter.neff(),
         filter.params().particles
     );
+    if filter.params().scan_odometry {
+        let (matched, dead) = filter.scan_odometry_counts();
+        println!("scan odometry: {matched} scans matched, {dead} kept the raw odometry's increment");
+    }
     if filter.params().odometry_calibration > 0.0 {
         let [scale, heading] = filter.odometry_calibration();
         println!(
@@ -265,6 +273,10 @@ pub fn run(args: SlamArgs) -> Result<ExitCode> {
                 "line_odometry": r.line_odometry,
             },
             "odometry_jumps": jumps.len(),
+            "scan_odometry": filter.params().scan_odometry.then(|| {
+                let (matched, dead) = filter.scan_odometry_counts();
+                json!({ "matched": matched, "raw": dead })
+            }),
             "metric": score.as_ref().map(|s| super::eval::to_json(s, args.tolerance, 10)),
         });
         super::eval::write_json(path, &summary)?;

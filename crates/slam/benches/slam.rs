@@ -1,5 +1,7 @@
-//! Criterion benchmarks: one filter update (30 particles, 667-beam Hokuyo scan), and the memory of 30
-//! particles after mapping a 50 m corridor (printed, not timed).
+//! Criterion benchmarks: one filter update (30 particles, 667-beam Hokuyo scan); one metre of a SICK-class
+//! log (180 and 361 beams, 30 particles: the scans in between and the update at its end) with the GMapping
+//! and the matched presets; and the memory of 30 particles after mapping a 50 m corridor (printed, not
+//! timed).
 //!
 //! The update is measured in the state a run is in: each iteration clones the filter and, untimed, processes
 //! one update first, so that the particles own the tiles the timed update writes, as they do in the run
@@ -68,6 +70,42 @@ fn update(c: &mut Criterion) {
     });
 }
 
+/// The office loop seen by a SICK-class lidar of `beams` beams over 180° (80 m), 0.05 m per scan.
+fn sick_office(beams: usize) -> synthetic::SyntheticRun {
+    let lidar = Lidar { fov: std::f64::consts::PI, beams, range_max: 80.0, ..Lidar::hokuyo() };
+    let path = synthetic::waypoint_path(&synthetic::office_loop(), 0.05, 0.1);
+    synthetic::simulate(&synthetic::office_map(), &path, 0.1, &lidar, pose(0.0, 0.0, 0.0), &drift(), 1)
+}
+
+fn metre_of_log(c: &mut Criterion) {
+    for beams in [180, 361] {
+        let run = sick_office(beams);
+        for (name, params) in [("gmapping", SlamParams::default()), ("matched", SlamParams::matched())] {
+            let mut f = Rbpf::new(params, run.laser_offset, 1).expect("valid params");
+            // 20 m mapped; the benchmark feeds the next metre (20 scans), whose last scan is an update.
+            let stop = 400;
+            for k in 0..stop {
+                f.process(&run.odometry[k], &run.scans[k]).expect("synthetic input is valid");
+            }
+            c.bench_function(&format!("rbpf_metre_30p_{beams}beams_{name}"), |b| {
+                b.iter_batched(
+                    || f.clone(),
+                    |mut f| {
+                        let mut updates = 0;
+                        for k in stop..stop + 20 {
+                            let out = f.process(&run.odometry[k], &run.scans[k]).expect("valid");
+                            updates += usize::from(out.is_processed());
+                        }
+                        assert!(updates >= 1, "a metre holds an update");
+                        f
+                    },
+                    BatchSize::SmallInput,
+                )
+            });
+        }
+    }
+}
+
 fn memory(_c: &mut Criterion) {
     let map = synthetic::corridor_map(52.0);
     let path = synthetic::waypoint_path(&[(1.0, 2.5), (51.0, 2.5)], 0.05, 0.1);
@@ -92,5 +130,5 @@ fn memory(_c: &mut Criterion) {
     );
 }
 
-criterion_group!(benches, update, memory);
+criterion_group!(benches, update, metre_of_log, memory);
 criterion_main!(benches);

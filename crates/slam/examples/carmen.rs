@@ -20,6 +20,7 @@ fn main() {
             "seed" => seed = v.parse().expect("a seed"),
             "odometry" => options.odometry = v.parse::<OdometrySource>().expect("an odometry source"),
             "map" => map_out = Some(v.to_string()),
+            "latency" => options.scan_latency = v.parse().expect("seconds"),
             _ => params.set(k, v).expect("a parameter"),
         }
     }
@@ -28,19 +29,65 @@ fn main() {
     let mut f = Rbpf::new(params, log.scans[0].laser_offset, seed).expect("parameters");
     let t = std::time::Instant::now();
     let mut processed = Vec::new();
+    let mut odometry: Vec<Pose2> = Vec::new();
     for (i, rec) in log.scans.iter().enumerate() {
         if f.process(&rec.odometry, &rec.scan).expect("a reading").is_processed() {
             processed.push(i);
         }
+        odometry.push(f.odometry_pose().expect("a pose"));
+        if let Ok(r) = std::env::var("DEBUG_RANGE") {
+            let (a, b) = r.split_once(',').expect("a,b");
+            let st = rec.scan.stamp;
+            if st >= a.parse::<f64>().expect("a") && st <= b.parse::<f64>().expect("b") {
+                let (x, y, t) = mrslam_core::pose::pose_xyt(&rec.odometry.pose);
+                let (cx, cy, ct) = mrslam_core::pose::pose_xyt(odometry.last().expect("pushed"));
+                let valid = (0..rec.scan.len()).filter(|&k| rec.scan.is_valid(k)).count();
+                println!("{st:.3} raw {x:.3} {y:.3} {:.2} corrected {cx:.3} {cy:.3} {:.2} valid {valid} {:?}", t.to_degrees(), ct.to_degrees(), f.scan_odometry_counts());
+            }
+        }
     }
     let secs = t.elapsed().as_secs_f64();
     let stamps: Vec<f64> = log.scans.iter().map(|r| r.scan.stamp).collect();
-    let odometry: Vec<Pose2> = log.scans.iter().map(|r| r.odometry.pose).collect();
+    if std::env::var("ODOMETRY_ONLY").is_ok() {
+        let traj: Vec<StampedPose> =
+            stamps.iter().zip(&odometry).map(|(&stamp, &pose)| StampedPose { stamp, pose }).collect();
+        let s = relations::score(&traj, &rels, 0.001);
+        println!(
+            "odometry alone: {:.4} ± {:.4} m (max {:.3}), {:.3} ± {:.3} deg (max {:.2}), scan odometry {:?}",
+            s.translation.mean,
+            s.translation.std,
+            s.translation.max,
+            s.rotation.mean.to_degrees(),
+            s.rotation.std.to_degrees(),
+            s.rotation.max.to_degrees(),
+            f.scan_odometry_counts()
+        );
+    }
     let anchors: Vec<(usize, Pose2)> = processed.iter().copied().zip(f.trajectory().into_iter().map(|k| k.1)).collect();
     let poses = poses_at_every_scan(&stamps, &odometry, &anchors).expect("processed scans");
     let traj: Vec<StampedPose> = stamps.iter().zip(poses).map(|(&stamp, pose)| StampedPose { stamp, pose }).collect();
     let s = relations::score(&traj, &rels, 0.001);
     let c = f.counters();
+    let split = |long: bool| {
+        let e: Vec<_> = s.errors.iter().filter(|e| ((e.t2 - e.t1).abs() > 10.0) == long).collect();
+        let n = e.len().max(1) as f64;
+        (e.len(), e.iter().map(|e| e.translation).sum::<f64>() / n, e.iter().map(|e| e.rotation).sum::<f64>().to_degrees() / n)
+    };
+    let (ns, ts, rs) = split(false);
+    let (nl, tl, rl) = split(true);
+    println!("  short (<=10 s) {ns}: {ts:.4} m {rs:.3} deg; long {nl}: {tl:.4} m {rl:.3} deg");
+    if std::env::var("WORST_ROT").is_ok() {
+        let mut v = s.errors.clone();
+        v.sort_by(|a, b| b.rotation.total_cmp(&a.rotation));
+        for w in v.iter().take(8) {
+            println!("  worst rot {:.2}-{:.2} s: {:.3} m {:.2} deg", w.t1, w.t2, w.translation, w.rotation.to_degrees());
+        }
+    }
+    if std::env::var("WORST").is_ok() {
+        for w in s.worst(8) {
+            println!("  worst {:.1}-{:.1} s: {:.3} m {:.2} deg", w.t1, w.t2, w.translation, w.rotation.to_degrees());
+        }
+    }
     let duration = stamps[stamps.len() - 1] - stamps[0];
     println!(
         "seed {seed}: {:.4} ± {:.4} m (max {:.3}), {:.3} ± {:.3} deg (max {:.2}), used {} missing {}, {} processed, {} resamples, {:.1} s = {:.1}x real time",

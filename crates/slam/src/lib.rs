@@ -25,6 +25,7 @@ pub mod particle;
 pub mod rbpf;
 pub mod resample;
 pub mod scan_matcher;
+pub mod scan_odometry;
 pub mod synthetic;
 pub mod tile_map;
 

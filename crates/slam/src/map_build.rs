@@ -5,6 +5,10 @@
 //! hits/visits > `occ_thresh` and free otherwise; unvisited cells are unknown. The grid holds log-odds
 //! ±[`ROS_LOGODDS_LIMIT`] (p ≈ 0.88 / 0.12, beyond core's 0.65 / 0.35 thresholds) and 0 for unknown, so
 //! it reads back from map_server files unchanged.
+//!
+//! With `wall_hits` > 0 (not GMapping) a beam's free-space trace stops at the first cell on its way that at
+//! least `wall_hits` beams of the trajectory ended in: beams that passed through glass, or past a wall's
+//! edge at a grazing angle, then no longer carve free space behind the wall.
 
 use crate::params::SlamParams;
 use crate::particle::TrajectoryNode;
@@ -66,7 +70,26 @@ pub fn build_map(nodes: &[&TrajectoryNode], laser: &Xyt, params: &SlamParams) ->
     }
     let mut hits = vec![0u32; w * h];
     let mut visits = vec![0u32; w * h];
-    // Pass 2: trace.
+    // Pass 2 (with `wall_hits`): the hits alone, so that pass 3 knows the walls before it traces.
+    let wall = params.wall_hits;
+    if wall > 0 {
+        for n in nodes {
+            let lp = sensor(&n.pose, laser);
+            let (sx, sy) = (lp.x * inv - x0 as f64, lp.y * inv - y0 as f64);
+            for i in 0..n.scan.len() {
+                let Some((r, true)) = beam_end(&n.scan, i, params) else {
+                    continue;
+                };
+                let a = lp.t + n.scan.angle(i);
+                let (cx, cy) = ((sx + r * a.cos() * inv).floor() as i64, (sy + r * a.sin() * inv).floor() as i64);
+                if cx >= 0 && cy >= 0 && (cx as usize) < w && (cy as usize) < h {
+                    let k = cy as usize * w + cx as usize;
+                    hits[k] = hits[k].saturating_add(1);
+                }
+            }
+        }
+    }
+    // Pass 3: trace.
     for n in nodes {
         let lp = sensor(&n.pose, laser);
         let (sx, sy) = (lp.x * inv - x0 as f64, lp.y * inv - y0 as f64);
@@ -84,8 +107,14 @@ pub fn build_map(nodes: &[&TrajectoryNode], laser: &Xyt, params: &SlamParams) ->
                 }
                 let k = cy as usize * w + cx as usize;
                 visits[k] = visits[k].saturating_add(1);
-                if hit && (cx, cy) == end {
-                    hits[k] = hits[k].saturating_add(1);
+                if (cx, cy) == end {
+                    if hit && wall == 0 {
+                        hits[k] = hits[k].saturating_add(1);
+                    }
+                } else if wall > 0 && hits[k] >= wall {
+                    // a wall (or glass) that other beams ended on: this beam went through it, so the space
+                    // beyond is not known to be free from here
+                    break;
                 }
             }
         }
@@ -105,4 +134,53 @@ pub fn build_map(nodes: &[&TrajectoryNode], laser: &Xyt, params: &SlamParams) ->
         .collect();
     let origin = pose(x0 as f64 * params.delta, y0 as f64 * params.delta, 0.0);
     OccupancyGrid::from_cells(w, h, params.delta, origin, cells).ok()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::sync::Arc;
+
+    #[test]
+    fn with_wall_hits_a_beam_through_a_wall_does_not_clear_the_space_behind_it() {
+        // Ten scans from the origin see a wall 2 m ahead (beams at -10°..10°, every 1°); in the last one the
+        // straight-ahead beam passes through it (glass) and returns from 6 m.
+        let scan = |through: bool| LaserScan {
+            stamp: 0.0,
+            angle_min: -10f64.to_radians(),
+            angle_increment: 1f64.to_radians(),
+            range_min: 0.1,
+            range_max: 20.0,
+            ranges: (0..21)
+                .map(|i| {
+                    let a = (-10.0 + i as f64).to_radians();
+                    if through && i == 10 { 6.0 } else { (2.0 / a.cos()) as f32 }
+                })
+                .collect(),
+        };
+        let nodes: Vec<TrajectoryNode> = (0..10)
+            .map(|k| TrajectoryNode {
+                stamp: k as f64,
+                pose: Xyt { x: 0.0, y: 0.0, t: 0.0 },
+                scan: Arc::new(scan(k == 9)),
+                parent: None,
+            })
+            .collect();
+        let refs: Vec<&TrajectoryNode> = nodes.iter().collect();
+        let laser = Xyt { x: 0.0, y: 0.0, t: 0.0 };
+        let state_at = |params: &SlamParams, x: f64| {
+            let map = build_map(&refs, &laser, params).unwrap();
+            let p = nalgebra::Point2::new(x, 0.0);
+            let (cx, cy) = map.world_to_cell(&p).unwrap();
+            map.state(cx, cy)
+        };
+        let gmapping = SlamParams::default();
+        let walls = SlamParams { wall_hits: 2, ..SlamParams::default() };
+        for params in [&gmapping, &walls] {
+            assert_eq!(state_at(params, 2.0 + 0.02), mrslam_core::CellState::Occupied, "the wall stays a wall");
+            assert_eq!(state_at(params, 1.0), mrslam_core::CellState::Free);
+        }
+        assert_eq!(state_at(&gmapping, 4.0), mrslam_core::CellState::Free, "GMapping: cleared behind the wall");
+        assert_eq!(state_at(&walls, 4.0), mrslam_core::CellState::Unknown, "wall_hits: not seen behind the wall");
+    }
 }

@@ -8,6 +8,7 @@ use crate::params::SlamParams;
 use crate::particle::{Particle, TrajectoryNode, ancestry};
 use crate::resample::{normalize, systematic};
 use crate::scan_matcher::{MatchResult, MotionPrior, PreparedScan, ScanMatcher, Scratch, Xyt};
+use crate::scan_odometry::ScanOdometry;
 use mrslam_core::pose::{pose_xyt, relative};
 use mrslam_core::{LaserScan, OccupancyGrid, Odometry, Pose2, pose};
 use rand::{Rng, SeedableRng};
@@ -150,6 +151,10 @@ pub struct Rbpf {
     motion_var: [f64; 3],
     /// Odometry calibration (see [`SlamParams::odometry_calibration`]).
     calibration: OdometryCalibration,
+    /// Scan-matched odometry (see [`SlamParams::scan_odometry`]).
+    scan_odometry: Option<ScanOdometry>,
+    /// The odometry pose of the last reading as the filter used it.
+    odometry: Option<Pose2>,
     counters: Counters,
 }
 
@@ -173,6 +178,7 @@ impl Rbpf {
         let matcher = ScanMatcher::from_params(&params, laser);
         let motion = MotionModel { srr: params.srr, srt: params.srt, str: params.str, stt: params.stt };
         let n = params.particles;
+        let scan_odometry = params.scan_odometry.then(|| ScanOdometry::new(&params, laser));
         Ok(Rbpf {
             particles: (0..n).map(|_| Particle::new(params.delta)).collect(),
             weights: vec![1.0 / n as f64; n],
@@ -191,6 +197,8 @@ impl Rbpf {
             angular_distance: 0.0,
             motion_var: [0.0; 3],
             calibration: OdometryCalibration::default(),
+            scan_odometry,
+            odometry: None,
             counters: Counters::default(),
         })
     }
@@ -198,6 +206,17 @@ impl Rbpf {
     /// The parameters in use.
     pub fn params(&self) -> &SlamParams {
         &self.params
+    }
+
+    /// The odometry pose of the last reading as the filter used it: the scan-matched one when
+    /// `scan_odometry` is on (in its own frame), else the reading's.
+    pub fn odometry_pose(&self) -> Option<Pose2> {
+        self.odometry
+    }
+
+    /// Scans the scan odometry matched and scans whose raw increment it kept; zeros when off.
+    pub fn scan_odometry_counts(&self) -> (usize, usize) {
+        self.scan_odometry.as_ref().map_or((0, 0), |s| s.counts())
     }
 
     /// Feeds one odometry reading and the scan taken with it.
@@ -211,6 +230,15 @@ impl Rbpf {
     /// beams are ignored ([`Counters::invalid_beams`]); a scan with no beams is skipped.
     pub fn process(&mut self, odom: &Odometry, scan: &LaserScan) -> Result<UpdateOutcome, SlamError> {
         self.validate(odom, scan)?;
+        let corrected;
+        let odom = match &mut self.scan_odometry {
+            Some(so) => {
+                corrected = Odometry { pose: so.update(&odom.pose, scan).0, ..*odom };
+                &corrected
+            }
+            None => odom,
+        };
+        self.odometry = Some(odom.pose);
         self.last_odom_stamp = Some(odom.stamp);
         self.last_scan_stamp = Some(scan.stamp);
         self.counters.readings += 1;

@@ -332,3 +332,60 @@ fn odometry_calibration_learns_the_drift_and_is_off_by_default() {
     let f = run_filter(&run, SlamParams::hokuyo(), 5);
     assert_eq!(f.odometry_calibration(), [0.0, 0.0]);
 }
+
+/// A SICK-class lidar as on the benchmark logs' robots: 181 beams over 180°, 20 m, 1 cm noise.
+fn sick() -> Lidar {
+    Lidar { fov: std::f64::consts::PI, beams: 181, range_max: 20.0, ..Lidar::hokuyo() }
+}
+
+/// The office loop with the SICK-class lidar and odometry that drifts a metre per lap.
+fn sick_office_run(seed: u64) -> SyntheticRun {
+    let path = synthetic::waypoint_path(&synthetic::office_loop(), 0.05, 0.1);
+    let drift = Drift { scale: 0.03, heading_per_m: 0.02, sigma_trans: 0.05, sigma_rot: 0.05 };
+    synthetic::simulate(&synthetic::office_map(), &path, 0.1, &sick(), pose(0.1, 0.0, 0.0), &drift, seed)
+}
+
+#[test]
+fn matched_preset_closes_the_loop_on_every_seed() {
+    let run = sick_office_run(5);
+    let end = |traj: &[(f64, Pose2)]| {
+        // error of the last pose relative to the first: what a missed loop closure leaves
+        let k = run.truth.len() - 1;
+        let t = relative(&run.truth[0].1, &run.truth[k].1);
+        let (stamp, p) = traj[traj.len() - 1];
+        assert_eq!(stamp, run.truth[k].0, "the last scan is processed or placed");
+        (p.translation.vector - t.translation.vector).norm()
+    };
+    let odo: Vec<(f64, Pose2)> = run.truth.iter().map(|(s, _)| (*s, Pose2::identity())).collect();
+    let odo = odometry_at(&run, &odo);
+    let (odo_rms, odo_end) = (rms_error(&odo, &run.truth), end(&odo));
+    assert!(odo_rms >= 0.5 && odo_end >= 0.5, "odometry must drift for this test to mean anything: {odo_rms} {odo_end}");
+    // The scan odometry alone (the filter never updates after the first scan): a lap's drift of centimetres.
+    let params = SlamParams { linear_update: 1e9, angular_update: 1e9, ..SlamParams::matched() };
+    let mut f = Rbpf::new(params, run.laser_offset, 0).unwrap();
+    let mut matched = Vec::new();
+    for (o, s) in run.odometry.iter().zip(&run.scans) {
+        f.process(o, s).unwrap();
+        matched.push((o.stamp, f.odometry_pose().unwrap()));
+    }
+    let first = matched[0].1;
+    let matched: Vec<(f64, Pose2)> = matched.iter().map(|(s, p)| (*s, relative(&first, p))).collect();
+    let (so_rms, so_end) = (rms_error(&matched, &run.truth), end(&matched));
+    assert!(so_rms <= 0.1 && so_end <= 0.1, "scan odometry alone: RMS {so_rms} m, end {so_end} m");
+    let mut errors = Vec::new();
+    for seed in 0..5 {
+        let f = run_filter(&run, SlamParams::matched(), seed);
+        let traj = f.trajectory();
+        let rms = rms_error(&traj, &run.truth);
+        // the filter's last pose is the best particle's, moved by odometry since its last update
+        let last = (run.truth[run.truth.len() - 1].0, f.best_pose());
+        let mut closed = traj.clone();
+        closed.push(last);
+        let e = end(&closed);
+        eprintln!("seed {seed}: RMS {rms} m, loop closure error {e} m");
+        assert!(rms <= 0.06 && e <= 0.05, "seed {seed}: RMS {rms} m, loop closure error {e} m");
+        errors.push(rms);
+    }
+    errors.sort_by(f64::total_cmp);
+    assert!(errors[4] <= 1.5 * errors[2] + 0.005, "no seed much worse than the median: {errors:?}");
+}
