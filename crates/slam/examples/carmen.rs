@@ -42,7 +42,12 @@ fn main() {
                 let (x, y, t) = mrslam_core::pose::pose_xyt(&rec.odometry.pose);
                 let (cx, cy, ct) = mrslam_core::pose::pose_xyt(odometry.last().expect("pushed"));
                 let valid = (0..rec.scan.len()).filter(|&k| rec.scan.is_valid(k)).count();
-                println!("{st:.3} raw {x:.3} {y:.3} {:.2} corrected {cx:.3} {cy:.3} {:.2} valid {valid} {:?}", t.to_degrees(), ct.to_degrees(), f.scan_odometry_counts());
+                println!(
+                    "{st:.3} raw {x:.3} {y:.3} {:.2} corrected {cx:.3} {cy:.3} {:.2} valid {valid} {:?}",
+                    t.to_degrees(),
+                    ct.to_degrees(),
+                    f.scan_odometry_counts()
+                );
             }
         }
     }
@@ -71,7 +76,11 @@ fn main() {
     let split = |long: bool| {
         let e: Vec<_> = s.errors.iter().filter(|e| ((e.t2 - e.t1).abs() > 10.0) == long).collect();
         let n = e.len().max(1) as f64;
-        (e.len(), e.iter().map(|e| e.translation).sum::<f64>() / n, e.iter().map(|e| e.rotation).sum::<f64>().to_degrees() / n)
+        (
+            e.len(),
+            e.iter().map(|e| e.translation).sum::<f64>() / n,
+            e.iter().map(|e| e.rotation).sum::<f64>().to_degrees() / n,
+        )
     };
     let (ns, ts, rs) = split(false);
     let (nl, tl, rl) = split(true);
@@ -80,7 +89,13 @@ fn main() {
         let mut v = s.errors.clone();
         v.sort_by(|a, b| b.rotation.total_cmp(&a.rotation));
         for w in v.iter().take(8) {
-            println!("  worst rot {:.2}-{:.2} s: {:.3} m {:.2} deg", w.t1, w.t2, w.translation, w.rotation.to_degrees());
+            println!(
+                "  worst rot {:.2}-{:.2} s: {:.3} m {:.2} deg",
+                w.t1,
+                w.t2,
+                w.translation,
+                w.rotation.to_degrees()
+            );
         }
     }
     if std::env::var("WORST").is_ok() {

@@ -137,7 +137,12 @@ pub struct Field {
     /// Build scratch: occupied cells of the padded window: padded x, padded y, mean (metres from the window's
     /// origin), hits, summed beam directions.
     occupied: Vec<(i32, i32, f32, f32, u32, [i16; 2])>,
+    /// Build scratch: per block of [`BLOCK`]² window cells, whether some lookup may need it.
+    needed: Vec<bool>,
 }
+
+/// Side, in cells, of the blocks in which [`Field::build_near`] decides which surfels to compute.
+const BLOCK: i32 = 8;
 
 impl Field {
     /// Origin of the window in the map frame, metres: subtract from map-frame points before [`Field::lookup`].
@@ -226,6 +231,14 @@ impl Field {
     /// allocated tiles), with surfels within `reach` cells of each cell's centre. `lines` off: every
     /// surfel is a point (the cell mean), as GMapping measures.
     pub fn build(&mut self, map: &TileMap, cells: [i32; 4], reach: i32, lines: bool) {
+        self.build_near(map, cells, reach, lines, &[]);
+    }
+
+    /// As [`Field::build`], but only the surfels that a lookup within `radius` metres of one of the map-frame
+    /// points `(x, y, radius)` of `near` can find are computed (all of them when `near` is empty); a lookup
+    /// elsewhere finds no surface. Where a scan's end points cover a small part of a large window (a long-range
+    /// lidar in a building), that is most of the build's work saved.
+    pub fn build_near(&mut self, map: &TileMap, cells: [i32; 4], reach: i32, lines: bool, near: &[(f64, f64, f64)]) {
         let [mut cx0, mut cy0, mut cx1, mut cy1] = cells;
         if let Some([mx0, my0, mx1, my1]) = map.cell_bounds() {
             cx0 = cx0.max(mx0);
@@ -310,12 +323,34 @@ impl Field {
             }
         }
 
+        // The blocks whose occupied cells can reach a lookup near one of the points.
+        let (bw, bh) = ((self.w + BLOCK - 1) / BLOCK, (self.h + BLOCK - 1) / BLOCK);
+        self.needed.clear();
+        self.needed.resize((bw * bh) as usize, near.is_empty());
+        for &(x, y, r) in near {
+            let (u, v) = (x * self.inv_delta - cx0 as f64, y * self.inv_delta - cy0 as f64);
+            let rc = r * self.inv_delta + (reach + 1) as f64;
+            let lo = |c: f64, n: i32| (((c - rc).floor() as i32).div_euclid(BLOCK)).clamp(0, n - 1);
+            let hi = |c: f64, n: i32| (((c + rc).ceil() as i32).div_euclid(BLOCK)).clamp(0, n - 1);
+            if u + rc < 0.0 || v + rc < 0.0 || u - rc >= self.w as f64 || v - rc >= self.h as f64 {
+                continue;
+            }
+            for by in lo(v, bh)..=hi(v, bh) {
+                let row = (by * bw) as usize;
+                self.needed[row + lo(u, bw) as usize..=row + hi(u, bw) as usize].fill(true);
+            }
+        }
+
         // Pass 2: each occupied cell's surfel, splatted onto the cells within reach of its mean.
         let reach2 = ((reach as f64 + 0.5) * delta).powi(2) as f32;
         let point_penalty = (POINT_PENALTY * delta * delta) as f32;
         let d32 = delta as f32;
         for k in 0..self.occupied.len() {
             let (ox, oy, mx, my, hits, dir) = self.occupied[k];
+            let (bx, by) = (((ox - pad) / BLOCK).clamp(0, bw - 1), ((oy - pad) / BLOCK).clamp(0, bh - 1));
+            if !self.needed[(by * bw + bx) as usize] {
+                continue;
+            }
             let mut s = Surfel { mx, my, nx: 0, ny: 0, kind: 0, stamp: self.stamp };
             // a point surfel's normal: the mean direction back to the sensors that saw it
             let (ddx, ddy) = (dir[0] as f64, dir[1] as f64);
@@ -350,6 +385,10 @@ impl Field {
             for y in ya..=yb {
                 let cy = (y as f32 + 0.5) * d32 - my;
                 let row = (y * self.w) as usize;
+                // the row's cells within reach: |cx| <= sqrt(reach² - cy²), rounded out by a cell
+                let half = (reach2 - cy * cy).max(0.0).sqrt() / d32;
+                let mxc = mx / d32 - 0.5;
+                let (xa, xb) = (xa.max((mxc - half).floor() as i32), xb.min((mxc + half).ceil() as i32));
                 for x in xa..=xb {
                     let cx = (x as f32 + 0.5) * d32 - mx;
                     let d2 = cx * cx + cy * cy;

@@ -401,9 +401,18 @@ impl ScanMatcher {
             x1 = x1.max(px);
             y1 = y1.max(py);
         }
+        // Where the matcher may move each end point: the margin, plus the arc of the heading search and of
+        // the climb's first angular steps at its range.
+        let turn = self.heading_search + 2.0 * self.astep;
+        let near: Vec<(f64, f64, f64)> = scan
+            .hits
+            .iter()
+            .chain(&scan.matched)
+            .map(|b| (lp.x + c * b.x - s * b.y, lp.y + s * b.x + c * b.y, FIELD_MARGIN + b.r * turn))
+            .collect();
         let (a, b) = map.cell_of(x0 - FIELD_MARGIN, y0 - FIELD_MARGIN);
         let (c, d) = map.cell_of(x1 + FIELD_MARGIN, y1 + FIELD_MARGIN);
-        field.build(map, [a, b, c, d], self.field_reach, self.field_lines);
+        field.build_near(map, [a, b, c, d], self.field_reach, self.field_lines, &near);
     }
 
     /// Score, log-likelihood and matched beams of robot pose `p` on a likelihood field.
@@ -852,7 +861,7 @@ mod tests {
     fn the_proposal_concentrates_motion_samples_where_the_score_peaks() {
         // GMapping's proposal moves each particle's motion-model sample to the matcher's optimum on its map.
         // Mapped: the office from ten true poses along its first corridor; matched: the scan at the next true
-        // pose, from 100 samples spread as the motion model spreads them over a metre (10 cm, 0.1 rad).
+        // pose, from 100 samples spread as a motion model spreads them.
         use crate::synthetic::{self, Lidar};
         use rand::SeedableRng;
         use rand_distr::{Distribution, Normal};
@@ -862,8 +871,9 @@ mod tests {
         let at = |x: f64| mrslam_core::pose(x, 2.0, 0.02);
         // GMapping's hill climber has a narrow basin (its first steps are 5 cm and 0.05 rad) and stops at a
         // few centimetres; the matched preset's field matcher searches ±0.05 rad and refines to the optimum.
-        for (params, spread, shrink, bound) in
-            [(SlamParams::default(), 0.03, 2.0, 0.025), (SlamParams::matched(), 0.1, 5.0, 0.01)]
+        // Headings are spread by 0.03 rad, what the motion model adds over a metre of matched odometry.
+        for (params, spread, turn, shrink, bound) in
+            [(SlamParams::default(), 0.03, 0.03, 2.0, 0.025), (SlamParams::matched(), 0.1, 0.03, 4.0, 0.03)]
         {
             let m = ScanMatcher::from_params(&params, Xyt { x: 0.0, y: 0.0, t: 0.0 });
             let mut map = TileMap::new(params.delta);
@@ -880,20 +890,24 @@ mod tests {
             let truth = Xyt { x: 8.3, y: 2.0, t: 0.02 };
             let scan = lidar.scan(&office, &at(truth.x), 0.0, &mut rng);
             let scan = PreparedScan::new(&scan, 20.0, 20.0, params.lskip);
-            let (nxy, nt) = (Normal::new(0.0, spread).unwrap(), Normal::new(0.0, spread).unwrap());
-            let prior = MotionPrior { sx: spread, sy: spread, st: spread };
+            let (nxy, nt) = (Normal::new(0.0, spread).unwrap(), Normal::new(0.0, turn).unwrap());
+            let prior = MotionPrior { sx: spread, sy: spread, st: turn };
             let mut scratch = Scratch::default();
             let (mut before, mut after, mut heading) = (0.0, 0.0, 0.0);
             let n = 100;
             for _ in 0..n {
-                let init =
-                    Xyt { x: truth.x + nxy.sample(&mut rng), y: truth.y + nxy.sample(&mut rng), t: truth.t + nt.sample(&mut rng) };
+                let init = Xyt {
+                    x: truth.x + nxy.sample(&mut rng),
+                    y: truth.y + nxy.sample(&mut rng),
+                    t: truth.t + nt.sample(&mut rng),
+                };
                 let r = m.match_scan(&map, &init, &scan, Some(&prior), &mut scratch);
                 before += (init.x - truth.x).powi(2) + (init.y - truth.y).powi(2);
                 after += (r.pose.x - truth.x).powi(2) + (r.pose.y - truth.y).powi(2);
                 heading += (r.pose.t - truth.t).powi(2);
             }
-            let (before, after, heading) = ((before / n as f64).sqrt(), (after / n as f64).sqrt(), (heading / n as f64).sqrt());
+            let (before, after, heading) =
+                ((before / n as f64).sqrt(), (after / n as f64).sqrt(), (heading / n as f64).sqrt());
             assert!(
                 after <= bound && after * shrink <= before && heading <= 0.5f64.to_radians(),
                 "{:?}: samples {before} m from the truth, proposal {after} m and {heading} rad",

@@ -235,7 +235,10 @@ mod tests {
         let raw: Vec<Pose2> = run.odometry.iter().map(|o| o.pose).collect();
         let (raw_t, raw_r) = end_error(&raw, &path);
         let (t, r) = end_error(&corrected, &path);
-        assert!(raw_t > 1.0 && raw_r > 0.15, "the odometry must be bad for this test to mean anything: {raw_t} m {raw_r} rad");
+        assert!(
+            raw_t > 1.0 && raw_r > 0.15,
+            "the odometry must be bad for this test to mean anything: {raw_t} m {raw_r} rad"
+        );
         assert!(t < 0.1 && r < 0.01, "scan odometry's end pose error {t} m {r} rad");
         // Every increment, not just the end: no step is off by more than 2 cm or 0.5°.
         for i in 1..path.len() {
