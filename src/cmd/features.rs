@@ -34,6 +34,14 @@ pub struct FeaturesArgs {
 
 /// Runs `mrslam features`.
 pub fn run(args: FeaturesArgs) -> Result<ExitCode> {
+    if let Some(p) = &args.json {
+        super::paths::check_extension(p, "--json", &["json"])?;
+    }
+    if let Some(p) = &args.png {
+        super::paths::check_extension(p, "--png", &["png"])?;
+    }
+    let outputs: Vec<&Path> = [&args.json, &args.png].into_iter().flatten().map(PathBuf::as_path).collect();
+    super::paths::check_outputs(&outputs, &[&args.image])?;
     let (img, what) = load(&args.image, &args.encoding)?;
     let params = SiftParams { upscale: !args.no_upscale, max_features: args.max_features, ..SiftParams::default() };
     let mut sift = Sift::new(params);

@@ -1,5 +1,6 @@
 //! `mrslam map info|convert`: look at and convert ROS map_server maps.
 
+use super::paths::{self, extension};
 use anyhow::{Context, Result, bail};
 use clap::Subcommand;
 use mrslam_core::map_io::{self, GreyImage, MapMode, MapYaml};
@@ -58,6 +59,8 @@ pub fn run(cmd: MapCommand) -> Result<ExitCode> {
             print!("{}", info_text(&map, &grid));
         }
         MapCommand::Convert { input, output, resolution } => {
+            paths::check_output_kind(&output, "OUT", &["yaml", "yml", "pgm", "png"])?;
+            paths::check_outputs(&[&output], &[&input])?;
             let grid = load_map(&input, resolution)?;
             save_map(&grid, &output)?;
             println!(
@@ -72,6 +75,10 @@ pub fn run(cmd: MapCommand) -> Result<ExitCode> {
             if !(-0.9..0.95).contains(&overlap) {
                 bail!("--overlap {overlap}: must lie in [-0.9, 0.95)");
             }
+            for out in [&a, &b] {
+                paths::check_extension(out, "output", &["yaml", "yml"])?;
+            }
+            paths::check_outputs(&[&a, &b], &[&map])?;
             let grid = load_map(&map, 0.05)?;
             let spec = PairSpec { overlap, max_shift_m: max_shift, rotate: true };
             let pair = cut_pair(&grid, &spec, seed);
@@ -118,10 +125,6 @@ pub fn save_map(grid: &OccupancyGrid, path: &Path) -> Result<()> {
         other => bail!("{}: unknown output format `.{other}` (expected .yaml, .pgm or .png)", path.display()),
     }
     Ok(())
-}
-
-fn extension(path: &Path) -> String {
-    path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase()
 }
 
 /// The human summary `map info` prints.

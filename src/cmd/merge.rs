@@ -76,9 +76,19 @@ fn algorithm_parser() -> impl TypedValueParser<Value = Algorithm> {
 
 /// Runs `mrslam merge`.
 pub fn run(args: MergeArgs) -> Result<ExitCode> {
-    for p in [&args.output, &args.report, &args.matches_png].into_iter().flatten() {
-        super::check_output(p)?;
+    let kinds: [(&Option<PathBuf>, &str, &[&str]); 4] = [
+        (&args.output, "--output", &["yaml", "yml"]),
+        (&args.report, "--report", &["json"]),
+        (&args.matches_png, "--matches-png", &["png"]),
+        (&args.viz.rrd, "--rrd", &["rrd"]),
+    ];
+    for (path, flag, allowed) in kinds {
+        if let Some(p) = path {
+            super::paths::check_extension(p, flag, allowed)?;
+        }
     }
+    let outputs: Vec<&Path> = kinds.iter().filter_map(|(p, ..)| p.as_deref()).collect();
+    super::paths::check_outputs(&outputs, &[&args.a, &args.b])?;
     let a = map_io::read_ros_map(&args.a)?;
     let b = map_io::read_ros_map(&args.b)?;
     let (name_a, name_b) = pair_names(&args.a, &args.b);
