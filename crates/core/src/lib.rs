@@ -11,6 +11,7 @@ pub mod pose;
 pub mod raycast;
 pub mod relations;
 pub mod scan;
+pub mod toml_lines;
 
 pub use carmen::{CarmenError, CarmenLog, LaserSource, OdometrySource, ReadOptions, Repairs, ScanRecord};
 pub use grid::{CellState, GridError, LogOddsParams, OccupancyGrid};

@@ -41,7 +41,7 @@ pub enum StudyError {
         message: String,
     },
     /// A results file is malformed, or shards disagree.
-    #[error("{path}:{line}: {message}")]
+    #[error("{}: {message}", crate::scenario::at(path, *line))]
     Results {
         /// File at fault.
         path: PathBuf,

@@ -21,6 +21,7 @@ use super::shard::Shard;
 use crate::runner::{RunOptions, run};
 use crate::scenario::Scenario;
 use mrslam_core::pose;
+use mrslam_core::toml_lines::TomlLines;
 use mrslam_merge::Algorithm;
 use mrslam_sim::World;
 use rayon::prelude::*;
@@ -85,10 +86,6 @@ pub struct Sweep {
     pub vary: Vec<Vary>,
 }
 
-fn line_of(text: &str, needle: &str) -> usize {
-    text.lines().position(|l| l.contains(needle)).map_or(0, |i| i + 1)
-}
-
 impl Sweep {
     /// Reads and checks a sweep file (and the scenario it names); errors name the file, line and field.
     pub fn from_file(path: &Path) -> Result<Sweep, StudyError> {
@@ -98,16 +95,18 @@ impl Sweep {
             let line = e.span().map_or(0, |s| text[..s.start.min(text.len())].matches('\n').count() + 1);
             at(line, e.message().to_string())
         })?;
+        let lines = TomlLines::new(&text);
+        let line_of = |field: &str| lines.line(field);
         let dir = path.parent().unwrap_or(Path::new("."));
         let scenario = Scenario::from_file(&dir.join(&file.scenario))
-            .map_err(|e| at(line_of(&text, "scenario"), format!("scenario: {e}")))?;
+            .map_err(|e| at(line_of("scenario"), format!("scenario: {e}")))?;
         let algorithms = match &file.algorithms {
             Some(names) => parse_algorithms(names),
             None => super::check_algorithms(&scenario.merge.algorithms).map(|()| scenario.merge.algorithms.clone()),
         }
-        .map_err(|e| at(line_of(&text, "algorithms"), format!("algorithms: {e}")))?;
+        .map_err(|e| at(line_of("algorithms"), format!("algorithms: {e}")))?;
         if file.seeds.is_empty() {
-            return Err(at(line_of(&text, "seeds"), "seeds: give at least one seed".into()));
+            return Err(at(line_of("seeds"), "seeds: give at least one seed".into()));
         }
         let mut vary = Vec::new();
         for (i, v) in file.vary.iter().enumerate() {
@@ -115,7 +114,7 @@ impl Sweep {
             let robot = scenario.robots.iter().position(|r| r.name == v.robot).ok_or_else(|| {
                 let names: Vec<&str> = scenario.robots.iter().map(|r| r.name.as_str()).collect();
                 at(
-                    line_of(&text, &format!("\"{}\"", v.robot)),
+                    line_of(&f("robot")),
                     format!("{}: no robot `{}` in the scenario (robots: {})", f("robot"), v.robot, names.join(", ")),
                 )
             })?;
@@ -125,19 +124,19 @@ impl Sweep {
                 "speed" => Field::Speed,
                 other => {
                     return Err(at(
-                        line_of(&text, &format!("\"{other}\"")),
+                        line_of(&f("field")),
                         format!("{}: unknown field `{other}` (expected one of {})", f("field"), FIELDS.join(", ")),
                     ));
                 }
             };
             if v.values.is_empty() {
-                return Err(at(line_of(&text, "values"), format!("{}: give at least one value", f("values"))));
+                return Err(at(line_of(&f("values")), format!("{}: give at least one value", f("values"))));
             }
             if let Some(first) = file.vary.first()
                 && first.values.len() != v.values.len()
             {
                 return Err(at(
-                    0,
+                    line_of(&f("values")),
                     format!(
                         "{}: {} values, but vary[0] has {}: all [[vary]] lists step together and need equal lengths",
                         f("values"),
@@ -150,7 +149,7 @@ impl Sweep {
         }
         let sweep = Sweep { path: path.to_path_buf(), scenario, algorithms, seeds: file.seeds, vary };
         // Every variant must be drivable: check each waypoint and speed now, not an hour into the study.
-        let world = World::from_spec(&sweep.scenario.world).map_err(|e| at(0, e.to_string()))?;
+        let world = World::from_spec(&sweep.scenario.world).map_err(|e| at(line_of("scenario"), e.to_string()))?;
         for k in 0..sweep.variants() {
             let s = sweep.variant(k, sweep.seeds[0]);
             for (i, v) in sweep.vary.iter().enumerate() {
@@ -171,7 +170,8 @@ impl Sweep {
                     }),
                 };
                 if let Some(p) = problem {
-                    return Err(at(line_of(&text, "values"), format!("vary[{i}].values[{k}] = {value}: {p}")));
+                    let field = format!("vary[{i}].values[{k}]");
+                    return Err(at(line_of(&field), format!("{field} = {value}: {p}")));
                 }
             }
         }
@@ -266,4 +266,33 @@ fn run_trial(sweep: &Sweep, scenario: &Scenario, trial: usize) -> Result<Vec<Tri
             translation_error_at_end_m: m.translation_error_at_end_m,
         })
         .collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Writes `text` as a sweep beside the shipped scenarios and reads it.
+    fn sweep_error(text: &str) -> String {
+        let dir = tempfile::tempdir().unwrap();
+        let scenarios = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenarios");
+        let text = text.replace("SCENARIO", &scenarios.join("paper_corridor.toml").display().to_string());
+        let path = dir.path().join("sweep.toml");
+        std::fs::write(&path, text).unwrap();
+        Sweep::from_file(&path).unwrap_err().to_string()
+    }
+
+    #[test]
+    fn sweep_errors_name_the_line_of_the_value() {
+        let head = "# robots, values and routes are described below\nscenario = \"SCENARIO\"\nseeds = [1]\n";
+        let vary = |robot: &str, values: &str| {
+            format!("[[vary]]\nrobot = \"{robot}\"\nfield = \"speed\"\nvalues = {values}\n")
+        };
+        let e = sweep_error(&format!("{head}{}{}", vary("experia", "[0.3, 0.4]"), vary("prawn", "[0.3]")));
+        assert!(e.contains("sweep.toml:11: vary[1].values: 1 values, but vary[0] has 2"), "{e}");
+        let e = sweep_error(&format!("{head}{}{}", vary("experia", "[0.3, 0.4]"), vary("prawn", "[0.3, 9.0]")));
+        assert!(e.contains("sweep.toml:11: vary[1].values[1] = 9: speed 9 outside"), "{e}");
+        let e = sweep_error(&format!("{head}{}{}", vary("experia", "[0.3]"), vary("robbie", "[0.3]")));
+        assert!(e.contains("sweep.toml:9: vary[1].robot: no robot `robbie`"), "{e}");
+    }
 }
