@@ -124,3 +124,48 @@ fn output_names_say_what_is_written_and_are_checked_before_any_work() {
     assert!(text(&o.stdout).is_empty(), "no work done, no success printed: {}", text(&o.stdout));
     assert_eq!(snapshot(d), before, "nothing written");
 }
+
+#[test]
+fn nothing_doubtful_is_accepted_quietly() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let w = plan(d, "w", 21);
+    let other = plan(d, "other", 22);
+    // Maps with nothing to cut.
+    std::fs::write(d.join("unknown.pgm"), [b"P5\n40 30\n255\n".as_slice(), &[205u8; 40 * 30]].concat()).unwrap();
+    std::fs::write(d.join("unknown.yaml"), "image: unknown.pgm\nresolution: 0.05\norigin: [0, 0, 0]\n").unwrap();
+    std::fs::write(d.join("one.pgm"), b"P5\n1 1\n255\n\x00").unwrap();
+    std::fs::write(d.join("one.yaml"), "image: one.pgm\nresolution: 0.05\norigin: [0, 0, 0]\n").unwrap();
+    for m in ["unknown.yaml", "one.yaml"] {
+        let (a, b) = (d.join("a.yaml"), d.join("b.yaml"));
+        fails_with(&["map", "cut", p(&d.join(m)), p(&a), p(&b)], &[m, "too few to cut"]);
+        assert!(!a.exists() && !b.exists());
+    }
+    // A ratio above 1 accepts every match: refused.
+    fails_with(&["merge", p(&w), p(&other), "--ratio", "1.5"], &["--ratio", "1.5", "outside (0, 1]"]);
+    // A typo'd key in a map YAML is named (map_server ignores it, so the map still loads).
+    let typo = d.join("typo.yaml");
+    std::fs::write(&typo, "image: w.pgm\nresolution: 0.05\nresolutoin: 0.1\norigin: [0, 0, 0]\n").unwrap();
+    let o = mrslam(&["map", "info", p(&typo)]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    assert!(text(&o.stderr).contains("typo.yaml:3: unknown key `resolutoin` ignored"), "{}", text(&o.stderr));
+    // A missing image names the YAML that refers to it, and its line.
+    let gone = d.join("gone.yaml");
+    std::fs::write(&gone, "resolution: 0.05\nimage: nowhere.pgm\norigin: [0, 0, 0]\n").unwrap();
+    fails_with(&["map", "info", p(&gone)], &["gone.yaml:2: field `image`", "nowhere.pgm"]);
+    // A block-style origin, as map_server accepts it.
+    let block = d.join("block.yaml");
+    std::fs::write(&block, "image: w.pgm\nresolution: 0.05\norigin:\n  - -10.0\n  - -10.0\n  - 0.0\n").unwrap();
+    let o = mrslam(&["map", "info", p(&block)]);
+    assert!(text(&o.stdout).contains("x -10.000 m, y -10.000 m"), "{}{}", text(&o.stdout), text(&o.stderr));
+    // A gzipped log cut off in the middle is refused, saying so.
+    let mut log = String::new();
+    for k in 0..300 {
+        log += &format!("FLASER 3 1.0 2.0 3.0 0 0 0 0 0 0 {k}.0 h {k}.0\n");
+    }
+    let mut gz = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::fast());
+    std::io::Write::write_all(&mut gz, log.as_bytes()).unwrap();
+    let bytes = gz.finish().unwrap();
+    std::fs::write(d.join("cut.clf.gz"), &bytes[..bytes.len() / 2]).unwrap();
+    fails_with(&["log", "info", p(&d.join("cut.clf.gz"))], &["cut.clf.gz", "cut off"]);
+}

@@ -67,7 +67,7 @@ pub fn run(args: FeaturesArgs) -> Result<ExitCode> {
 fn load(path: &Path, encoding: &str) -> Result<(GrayImage, &'static str)> {
     let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
     if ext == "yaml" || ext == "yml" {
-        let grid = map_io::read_ros_map(path)?;
+        let grid = super::map::read_yaml_map(path)?;
         let enc = if encoding == "paper" { MapEncoding::PAPER } else { MapEncoding::WALLS };
         let img = MapImage::render(&grid, &enc, 8);
         let g = GrayImage::new(img.width, img.height, img.pixels).with_context(|| format!("{}", path.display()))?;

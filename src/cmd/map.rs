@@ -51,6 +51,14 @@ pub enum MapCommand {
     },
 }
 
+/// Fewest known cells a map must have for `map cut`.
+pub const MIN_KNOWN_TO_CUT: usize = 100;
+
+/// Reads a map YAML, printing a warning for each key map_server would ignore (a typo, most likely).
+pub fn read_yaml_map(path: &Path) -> Result<OccupancyGrid> {
+    Ok(map_io::read_ros_map_with(path, &mut |w| eprintln!("warning: {w}"))?)
+}
+
 /// Runs a map subcommand.
 pub fn run(cmd: MapCommand) -> Result<ExitCode> {
     match cmd {
@@ -80,8 +88,21 @@ pub fn run(cmd: MapCommand) -> Result<ExitCode> {
             }
             paths::check_outputs(&[&a, &b], &[&map])?;
             let grid = load_map(&map, 0.05)?;
+            let (free, occupied, _) = grid.state_counts();
+            if free + occupied < MIN_KNOWN_TO_CUT {
+                bail!(
+                    "{}: {} known cells ({}x{} map): too few to cut into a pair (need at least {MIN_KNOWN_TO_CUT})",
+                    map.display(),
+                    free + occupied,
+                    grid.width(),
+                    grid.height()
+                );
+            }
             let spec = PairSpec { overlap, max_shift_m: max_shift, rotate: true };
             let pair = cut_pair(&grid, &spec, seed);
+            if overlap > 0.0 && pair.overlap == 0.0 {
+                bail!("{}: the halves share no known cell although --overlap is {overlap}", map.display());
+            }
             map_io::write_ros_map(&pair.a, &a)?;
             map_io::write_ros_map(&pair.b, &b)?;
             let (x, y, th) = pose_xyt(&pair.t_a_b);
@@ -95,7 +116,7 @@ pub fn run(cmd: MapCommand) -> Result<ExitCode> {
 /// Loads a map from a YAML file, or from a bare image at the given resolution.
 pub fn load_map(path: &Path, resolution: f64) -> Result<OccupancyGrid> {
     match extension(path).as_str() {
-        "yaml" | "yml" => Ok(map_io::read_ros_map(path)?),
+        "yaml" | "yml" => read_yaml_map(path),
         "pgm" | "png" => {
             let img = map_io::read_grey_image(path)?;
             let meta = MapYaml {

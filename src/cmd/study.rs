@@ -4,7 +4,6 @@
 use anyhow::{Context, Result, bail};
 use clap::{Args, Subcommand};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use mrslam_core::map_io::read_ros_map;
 use mrslam_merge::floorplan::FloorplanParams;
 use mrslam_testbed::study::{
     self, MapSource, OverlapStudy, Shard, Sweep, TrialRow, collect, parse_range, run_overlap_study, run_sweep,
@@ -168,7 +167,7 @@ fn overlap(a: OverlapArgs) -> Result<ExitCode> {
         bail!("--resolution must be positive, got {}", a.resolution);
     }
     let source = if let Some(path) = &a.map {
-        MapSource::Map(read_ros_map(path).with_context(|| format!("--map {}", path.display()))?)
+        MapSource::Map(super::map::read_yaml_map(path).with_context(|| format!("--map {}", path.display()))?)
     } else if let Some(path) = &a.world {
         MapSource::Map(study::overlap::world_truth(path, a.resolution).context("--world")?)
     } else {
