@@ -14,10 +14,10 @@
 //! Trials: variant-major, `trial = variant * seeds.len() + seed index`. A trial's overlap is the run's
 //! observed overlap (Jaccard of the true cells each robot's beams crossed), not an assumed one.
 
-use super::StudyError;
 use super::algorithms::parse_algorithms;
 use super::results::{TrialRow, sort_rows};
 use super::shard::Shard;
+use super::{Progress, StudyError};
 use crate::runner::{RunOptions, run};
 use crate::scenario::Scenario;
 use mrslam_core::pose;
@@ -225,16 +225,16 @@ impl Sweep {
 }
 
 /// Runs the sweep's trials of this shard in parallel, calling `progress` after each.
-pub fn run_sweep(sweep: &Sweep, shard: Shard, progress: &(dyn Fn() + Sync)) -> Result<Vec<TrialRow>, StudyError> {
+pub fn run_sweep(sweep: &Sweep, shard: Shard, progress: &dyn Progress) -> Result<Vec<TrialRow>, StudyError> {
     let n_seeds = sweep.seeds.len();
-    let selected: Vec<usize> = (0..sweep.trials()).filter(|t| shard.selects(*t)).collect();
+    let selected: Vec<usize> = (0..sweep.trials()).filter(|t| shard.selects(*t) && !progress.skip(*t)).collect();
     let rows: Vec<Vec<TrialRow>> = selected
         .par_iter()
         .map(|&trial| {
             let scenario = sweep.variant(trial / n_seeds, sweep.seeds[trial % n_seeds]);
-            let r = run_trial(sweep, &scenario, trial);
-            progress();
-            r
+            let r = run_trial(sweep, &scenario, trial)?;
+            progress.finished(&r)?;
+            Ok(r)
         })
         .collect::<Result<_, _>>()?;
     let mut rows: Vec<TrialRow> = rows.into_iter().flatten().collect();
