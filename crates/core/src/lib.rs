@@ -6,6 +6,7 @@
 
 pub mod carmen;
 pub mod grid;
+pub mod input;
 pub mod map_io;
 pub mod pose;
 pub mod raycast;

@@ -170,7 +170,7 @@ pub fn read_ros_map(yaml_path: &Path) -> Result<OccupancyGrid, MapIoError> {
 
 /// Reads a map_server YAML file and the image it names, calling `warn` for each key map_server ignores.
 pub fn read_ros_map_with(yaml_path: &Path, warn: &mut dyn FnMut(String)) -> Result<OccupancyGrid, MapIoError> {
-    let text = std::fs::read_to_string(yaml_path).map_err(io_err(yaml_path))?;
+    let text = crate::input::read_text_limited(yaml_path, crate::input::CONFIG_LIMIT).map_err(io_err(yaml_path))?;
     let meta = parse_map_yaml_with(&text, yaml_path, warn)?;
     let image_path = resolve_image_path(yaml_path, &meta.image);
     let img = read_grey_image(&image_path).map_err(|cause| MapIoError::ImageOf {
@@ -407,18 +407,23 @@ pub fn parse_map_yaml_with(text: &str, path: &Path, warn: &mut dyn FnMut(String)
 /// the `image` crate. Colour images are averaged to grey as map_server does; dimensions are checked
 /// against [`MAX_CELLS`] before pixels are allocated.
 pub fn read_grey_image(path: &Path) -> Result<GreyImage, MapIoError> {
-    let bytes = std::fs::read(path).map_err(io_err(path))?;
+    let bytes = crate::input::read_limited(path, crate::input::DATA_LIMIT).map_err(io_err(path))?;
+    decode_grey_image(&bytes, path)
+}
+
+/// Decodes a grey image from its bytes (see [`read_grey_image`]); `path` only names it in errors.
+pub fn decode_grey_image(bytes: &[u8], path: &Path) -> Result<GreyImage, MapIoError> {
     if bytes.first() == Some(&b'P') {
-        return parse_pgm(&bytes, path);
+        return parse_pgm(bytes, path);
     }
-    let reader = image::ImageReader::new(std::io::Cursor::new(&bytes)).with_guessed_format().map_err(io_err(path))?;
+    let reader = image::ImageReader::new(std::io::Cursor::new(bytes)).with_guessed_format().map_err(io_err(path))?;
     let (w, h) =
         reader.into_dimensions().map_err(|e| MapIoError::Image { path: path.to_path_buf(), message: e.to_string() })?;
     let (w, h) = (w as usize, h as usize);
     if w.saturating_mul(h) > MAX_CELLS {
         return Err(MapIoError::TooLarge { path: path.to_path_buf(), width: w, height: h });
     }
-    let img = image::ImageReader::new(std::io::Cursor::new(&bytes))
+    let img = image::ImageReader::new(std::io::Cursor::new(bytes))
         .with_guessed_format()
         .map_err(io_err(path))?
         .decode()

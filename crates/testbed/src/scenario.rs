@@ -292,11 +292,8 @@ fn apply<T: Copy>(pairs: &mut [(&mut T, Option<T>)]) {
 impl Scenario {
     /// Reads and resolves a scenario file (and the world it names).
     pub fn from_file(path: &Path) -> Result<Scenario, ScenarioError> {
-        let text = std::fs::read_to_string(path).map_err(|e| ScenarioError {
-            path: path.to_path_buf(),
-            line: 0,
-            field: "file".into(),
-            message: e.to_string(),
+        let text = mrslam_core::input::read_text_limited(path, mrslam_core::input::CONFIG_LIMIT).map_err(|e| {
+            ScenarioError { path: path.to_path_buf(), line: 0, field: "file".into(), message: e.to_string() }
         })?;
         Self::parse(&text, path)
     }

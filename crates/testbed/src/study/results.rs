@@ -140,7 +140,17 @@ pub fn read_results(path: &Path) -> Result<Vec<TrialRow>, StudyError> {
 
 /// Reads a `results.csv` with each row's 1-based line.
 fn read_numbered(path: &Path) -> Result<Vec<(usize, TrialRow)>, StudyError> {
-    let text = std::fs::read_to_string(path).map_err(|e| StudyError::file(path, e))?;
+    let text = mrslam_core::input::read_text_limited(path, mrslam_core::input::DATA_LIMIT)
+        .map_err(|e| StudyError::file(path, e))?;
+    parse_numbered(&text, path)
+}
+
+/// Parses the text of a `results.csv`, checking its header; `path` only names it in errors.
+pub fn parse_results(text: &str, path: &Path) -> Result<Vec<TrialRow>, StudyError> {
+    Ok(parse_numbered(text, path)?.into_iter().map(|(_, r)| r).collect())
+}
+
+fn parse_numbered(text: &str, path: &Path) -> Result<Vec<(usize, TrialRow)>, StudyError> {
     let err = |line: usize, message: String| StudyError::Results { path: path.to_path_buf(), line, message };
     let mut lines = text.lines().enumerate();
     match lines.next() {

@@ -89,13 +89,19 @@ pub struct Sweep {
 impl Sweep {
     /// Reads and checks a sweep file (and the scenario it names); errors name the file, line and field.
     pub fn from_file(path: &Path) -> Result<Sweep, StudyError> {
-        let text = std::fs::read_to_string(path).map_err(|e| StudyError::file(path, e))?;
+        let text = mrslam_core::input::read_text_limited(path, mrslam_core::input::CONFIG_LIMIT)
+            .map_err(|e| StudyError::file(path, e))?;
+        Self::parse(&text, path)
+    }
+
+    /// Checks a sweep from its text; `path` names it in errors and anchors the scenario's path.
+    pub fn parse(text: &str, path: &Path) -> Result<Sweep, StudyError> {
         let at = |line: usize, message: String| StudyError::Results { path: path.to_path_buf(), line, message };
-        let file: SweepFile = toml::from_str(&text).map_err(|e| {
-            let line = e.span().map_or(0, |s| text[..s.start.min(text.len())].matches('\n').count() + 1);
+        let file: SweepFile = toml::from_str(text).map_err(|e| {
+            let line = e.span().map_or(0, |s| mrslam_core::toml_lines::line_at(text, s.start));
             at(line, e.message().to_string())
         })?;
-        let lines = TomlLines::new(&text);
+        let lines = TomlLines::new(text);
         let line_of = |field: &str| lines.line(field);
         let dir = path.parent().unwrap_or(Path::new("."));
         let scenario = Scenario::from_file(&dir.join(&file.scenario))
