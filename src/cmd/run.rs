@@ -35,6 +35,10 @@ pub struct RunArgs {
 
 /// Runs `mrslam run`.
 pub fn run(args: RunArgs) -> Result<ExitCode> {
+    if let Some(rrd) = &args.viz.rrd {
+        super::paths::check_extension(rrd, "--rrd", &["rrd"])?;
+        super::paths::check_outputs(&[rrd], &[&args.scenario])?;
+    }
     let mut scenario = Scenario::from_file(&args.scenario)?;
     if let Some(s) = args.seed {
         scenario.seed = s;

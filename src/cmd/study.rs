@@ -214,7 +214,7 @@ fn finish(rows: &[TrialRow], out: &Path, trials: usize, seconds: Option<f64>) ->
     if let Some(s) = seconds {
         println!("{trials} trials ({} rows) in {s:.1} s: {:.2} trials/s", rows.len(), trials as f64 / s.max(1e-9));
     }
-    println!("outputs:  {} (results.csv, summary.csv, plot.png)", out.display());
+    println!("outputs:  {} (study.json, results.csv, summary.csv, plot.png)", out.display());
     Ok(ExitCode::SUCCESS)
 }
 

@@ -464,27 +464,31 @@ pub fn parse_pgm(bytes: &[u8], path: &Path) -> Result<GreyImage, MapIoError> {
     }
     let n = w * h;
     let scale = |v: usize| -> u8 { ((v.min(maxval) * 255 + maxval / 2) / maxval) as u8 };
-    let mut pixels = Vec::with_capacity(n);
     if binary {
         pos += 1; // exactly one whitespace byte after maxval
         let bpp = if maxval > 255 { 2 } else { 1 };
         let data = bytes.get(pos..).unwrap_or(&[]);
+        // Checked before any allocation: a header may claim any size.
         if data.len() < n * bpp {
             return Err(err(format!("truncated: {} of {} pixel bytes present", data.len(), n * bpp)));
         }
+        let mut pixels = Vec::with_capacity(n);
         if bpp == 1 {
             pixels.extend(data[..n].iter().map(|&v| scale(v as usize)));
         } else {
             pixels.extend(data[..2 * n].chunks_exact(2).map(|c| scale(((c[0] as usize) << 8) | c[1] as usize)));
         }
+        Ok(GreyImage { width: w, height: h, pixels })
     } else {
+        // Each ASCII pixel takes at least a digit and a separator: no more can be present than that allows.
+        let mut pixels = Vec::with_capacity(n.min(bytes.len().saturating_sub(pos) / 2 + 1));
         for k in 0..n {
             let v = next_number(bytes, &mut pos)
                 .ok_or_else(|| err(format!("truncated: pixel {k} of {n} missing or not a number")))?;
             pixels.push(scale(v));
         }
+        Ok(GreyImage { width: w, height: h, pixels })
     }
-    Ok(GreyImage { width: w, height: h, pixels })
 }
 
 /// Reads the next whitespace-separated decimal number, skipping `#` comments.
