@@ -36,8 +36,11 @@ pub struct RunArgs {
 /// Runs `mrslam run`.
 pub fn run(args: RunArgs) -> Result<ExitCode> {
     if let Some(rrd) = &args.viz.rrd {
-        super::paths::check_extension(rrd, "--rrd", &["rrd"])?;
-        super::paths::check_outputs(&[rrd], &[&args.scenario])?;
+        // A folder or a missing folder is reported when the recording opens.
+        if !rrd.is_dir() {
+            super::paths::check_extension(rrd, "--rrd", &["rrd"])?;
+        }
+        super::paths::check_not_input(rrd, &[&args.scenario])?;
     }
     let mut scenario = Scenario::from_file(&args.scenario)?;
     if let Some(s) = args.seed {
