@@ -8,9 +8,17 @@ mod cmd;
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
+/// The exit codes, shown under `--help` (README.md has the same table).
+const EXIT_CODES: &str = "\
+Exit codes:
+  0  success
+  1  failure or bad input: a file, a value or the command line itself (the message names the file, line
+     and field, or the flag)
+  2  `mrslam merge` only: the merge was refused (no reliable transform); no merged map is written";
+
 /// Multi-robot SLAM and map merging testbed: simulate, map, merge, evaluate.
 #[derive(Parser)]
-#[command(name = "mrslam", version, about, long_about = None, propagate_version = true)]
+#[command(name = "mrslam", version, about, long_about = None, propagate_version = true, after_help = EXIT_CODES)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -41,7 +49,14 @@ enum Command {
 }
 
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => {
+            // clap exits 2 on a usage error; 2 is reserved for a refused merge, so usage errors exit 1.
+            let _ = e.print();
+            return if e.use_stderr() { ExitCode::from(1) } else { ExitCode::SUCCESS };
+        }
+    };
     let result = match cli.command {
         Command::Map(c) => cmd::map::run(c),
         Command::Log(c) => cmd::log::run(c),

@@ -114,7 +114,10 @@ fn convert_to_unwritable_place_fails_and_leaves_nothing() {
     let dir = tempfile::tempdir().unwrap();
     let map = small_map(dir.path());
     let out = dir.path().join("no/such/dir/out.yaml");
-    assert_fails_with(&["map", "convert", map.to_str().unwrap(), out.to_str().unwrap()], &["out.pgm"]);
+    assert_fails_with(
+        &["map", "convert", map.to_str().unwrap(), out.to_str().unwrap()],
+        &["out.yaml", "does not exist"],
+    );
     assert!(!out.exists());
 }
 

@@ -172,3 +172,72 @@ fn the_shipped_sweep_file_is_valid() {
     assert!(stdout.contains("9 trials"), "{stdout}");
     assert!(stdout.contains("experia.route_end_x=34"), "{stdout}");
 }
+
+/// A map-level study of `trials` trials at two overlaps, as a command to spawn.
+fn study_command(out: &Path, seed: &str, trials: &str, extra: &[&str]) -> Command {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_mrslam"));
+    c.args(["study", "overlap", "--floorplans", "2", "--floorplan-size", "12x10", "--overlaps", "0.2,0.4"])
+        .args(["--trials", trials, "--algorithms", "sift,rmap", "--seed", seed, "--quiet", "--out"])
+        .arg(out)
+        .args(extra);
+    c
+}
+
+#[test]
+fn an_interrupted_study_keeps_its_finished_trials_and_resumes() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("study");
+    let results = out.join("results.csv");
+    let mut child = study_command(&out, "5", "60", &[]).spawn().unwrap();
+    // Interrupt as soon as a few trials are written.
+    let start = std::time::Instant::now();
+    while std::fs::read_to_string(&results).map_or(0, |t| t.lines().count()) < 5 {
+        assert!(start.elapsed().as_secs() < 60, "no trial written within a minute");
+        assert!(child.try_wait().unwrap().is_none(), "the study ended before it was interrupted");
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    let kill = Command::new("kill").args(["-INT", &child.id().to_string()]).status().unwrap();
+    assert!(kill.success());
+    assert!(!child.wait().unwrap().success());
+    let (header, kept) = csv(&results);
+    assert_eq!(header, COLUMNS);
+    assert!(kept.len() >= 4 && kept.len() < 240, "{} rows survive the interruption", kept.len());
+
+    // Started afresh in the same folder: refused, nothing lost.
+    let o = study_command(&out, "5", "60", &[]).output().unwrap();
+    assert_eq!(o.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("--resume"), "{}", String::from_utf8_lossy(&o.stderr));
+    // Resumed with other parameters: refused.
+    let o = study_command(&out, "6", "60", &["--resume"]).output().unwrap();
+    assert_eq!(o.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("`seed` is `5` there but `6` here"));
+    // Resumed: the missing trials run, each trial once, the kept rows as they were.
+    let o = study_command(&out, "5", "60", &["--resume"]).output().unwrap();
+    ok(&o);
+    assert!(String::from_utf8_lossy(&o.stdout).contains("trials already done"));
+    let (_, rows) = csv(&results);
+    assert_eq!(rows.len(), 2 * 60 * 2);
+    let keys: std::collections::BTreeSet<(String, String)> =
+        rows.iter().map(|r| (r[0].clone(), r[4].clone())).collect();
+    assert_eq!(keys.len(), rows.len(), "a trial twice");
+    for k in kept.iter().filter(|k| kept.iter().filter(|r| r[0] == k[0]).count() == 2) {
+        assert!(rows.contains(k), "kept row {k:?} lost");
+    }
+}
+
+#[test]
+fn collect_refuses_shards_of_different_studies() {
+    let dir = tempfile::tempdir().unwrap();
+    let (s0, s1, joined) = (dir.path().join("s0"), dir.path().join("s1"), dir.path().join("joined"));
+    ok(&study_command(&s0, "5", "2", &["--shard", "0/2"]).output().unwrap());
+    ok(&study_command(&s1, "6", "2", &["--shard", "1/2"]).output().unwrap());
+    let o =
+        mrslam(&["study", "collect", s0.to_str().unwrap(), s1.to_str().unwrap(), "--out", joined.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(1));
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(e.contains("study.json") && e.contains("`seed` is `6` there but `5` here"), "{e}");
+    assert!(!joined.exists(), "nothing written");
+    // Collected into one of the shards: refused.
+    let o = mrslam(&["study", "collect", s0.to_str().unwrap(), "--out", s0.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(1));
+}

@@ -198,3 +198,22 @@ fn merge_records_both_maps_keypoints_matches_and_the_merged_map() {
     assert!(text(&o.stderr).contains(p(&bad)), "{}", text(&o.stderr));
     assert!(!text(&o.stdout).contains("ACCEPTED"), "the merge ran: {}", text(&o.stdout));
 }
+
+#[test]
+fn a_rerun_into_the_same_folder_leaves_no_stale_recording() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let scenario = short_scenario(d, 2.0);
+    let out = d.join("out");
+    let o = run_with_rrd(&scenario, &out, &out.join("run.rrd"));
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    assert!(out.join("run.rrd").exists());
+    // The same again, recorded again: the recording is kept.
+    let o = run_with_rrd(&scenario, &out, &out.join("run.rrd"));
+    assert!(o.status.success() && out.join("run.rrd").exists(), "{}", text(&o.stderr));
+    // Without --rrd, the folder's recording would show the earlier run beside this run's report: removed.
+    let o = mrslam(&["run", p(&scenario), "--quiet", "--out", p(&out)]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    assert!(!out.join("run.rrd").exists(), "stale recording kept");
+    assert!(text(&o.stdout).contains("removed:") && text(&o.stdout).contains("run.rrd"), "{}", text(&o.stdout));
+}

@@ -4,13 +4,26 @@
 
 use mrslam_testbed::report::RunReport;
 use mrslam_testbed::runner::{RunOptions, run, write_outputs};
-use mrslam_testbed::scenario::Scenario;
+use mrslam_testbed::scenario::{ControllerKind, MergeWhen, Scenario};
 use std::path::Path;
 
 fn run_scenario(name: &str) -> RunReport {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios").join(format!("{name}.toml"));
     let scenario = Scenario::from_file(&path).expect("the shipped scenario loads");
-    let out = run(&scenario, RunOptions::default()).expect("the scenario runs");
+    let last = std::cell::Cell::new((0.0, 0.0));
+    let opts = RunOptions { progress: Some(Box::new(|t, end| last.set((t, end)))), ..RunOptions::default() };
+    let out = run(&scenario, opts).expect("the scenario runs");
+    // The progress runs to the run's real end: at a rendezvous of routed robots, long before the duration.
+    let (t, end) = last.get();
+    let routed = scenario.robots.iter().all(|r| r.controller == ControllerKind::Waypoints);
+    if routed && scenario.merge.when == MergeWhen::Rendezvous {
+        let stop = out.report.merge_at_s;
+        assert!(stop < 0.9 * scenario.duration, "{name}: the rendezvous at {stop} s comes before the end");
+        assert!(
+            (end - stop).abs() <= 0.1 * stop,
+            "{name}: last progress ({t} s) expected the end at {end} s, not {stop} s"
+        );
+    }
     let dir = tempfile::tempdir().unwrap();
     write_outputs(&out, dir.path()).unwrap();
     for f in ["experia.yaml", "experia.pgm", "prawn.yaml", "truth.yaml", "report.json"] {

@@ -42,8 +42,8 @@ pub fn run(cmd: EvalCommand) -> Result<ExitCode> {
                 bail!("--tolerance {tolerance}: must be a non-negative number of seconds");
             }
             if let Some(out) = &json {
-                super::check_output(out)?;
-                super::check_not_input(out, &[&trajectory, &relations])?;
+                super::paths::check_extension(out, "--json", &["json"])?;
+                super::paths::check_outputs(&[out], &[&trajectory, &relations])?;
             }
             let traj = relations::read_trajectory(&trajectory)?;
             let rels = relations::read_relations(&relations)?;

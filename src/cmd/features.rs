@@ -34,6 +34,14 @@ pub struct FeaturesArgs {
 
 /// Runs `mrslam features`.
 pub fn run(args: FeaturesArgs) -> Result<ExitCode> {
+    if let Some(p) = &args.json {
+        super::paths::check_extension(p, "--json", &["json"])?;
+    }
+    if let Some(p) = &args.png {
+        super::paths::check_extension(p, "--png", &["png"])?;
+    }
+    let outputs: Vec<&Path> = [&args.json, &args.png].into_iter().flatten().map(PathBuf::as_path).collect();
+    super::paths::check_outputs(&outputs, &[&args.image])?;
     let (img, what) = load(&args.image, &args.encoding)?;
     let params = SiftParams { upscale: !args.no_upscale, max_features: args.max_features, ..SiftParams::default() };
     let mut sift = Sift::new(params);
@@ -59,7 +67,7 @@ pub fn run(args: FeaturesArgs) -> Result<ExitCode> {
 fn load(path: &Path, encoding: &str) -> Result<(GrayImage, &'static str)> {
     let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
     if ext == "yaml" || ext == "yml" {
-        let grid = map_io::read_ros_map(path)?;
+        let grid = super::map::read_yaml_map(path)?;
         let enc = if encoding == "paper" { MapEncoding::PAPER } else { MapEncoding::WALLS };
         let img = MapImage::render(&grid, &enc, 8);
         let g = GrayImage::new(img.width, img.height, img.pixels).with_context(|| format!("{}", path.display()))?;

@@ -1,5 +1,6 @@
 //! `mrslam map info|convert`: look at and convert ROS map_server maps.
 
+use super::paths::{self, extension};
 use anyhow::{Context, Result, bail};
 use clap::Subcommand;
 use mrslam_core::map_io::{self, GreyImage, MapMode, MapYaml};
@@ -50,6 +51,14 @@ pub enum MapCommand {
     },
 }
 
+/// Fewest known cells a map must have for `map cut`.
+pub const MIN_KNOWN_TO_CUT: usize = 100;
+
+/// Reads a map YAML, printing a warning for each key map_server would ignore (a typo, most likely).
+pub fn read_yaml_map(path: &Path) -> Result<OccupancyGrid> {
+    Ok(map_io::read_ros_map_with(path, &mut |w| eprintln!("warning: {w}"))?)
+}
+
 /// Runs a map subcommand.
 pub fn run(cmd: MapCommand) -> Result<ExitCode> {
     match cmd {
@@ -58,6 +67,8 @@ pub fn run(cmd: MapCommand) -> Result<ExitCode> {
             print!("{}", info_text(&map, &grid));
         }
         MapCommand::Convert { input, output, resolution } => {
+            paths::check_output_kind(&output, "OUT", &["yaml", "yml", "pgm", "png"])?;
+            paths::check_outputs(&[&output], &[&input])?;
             let grid = load_map(&input, resolution)?;
             save_map(&grid, &output)?;
             println!(
@@ -72,9 +83,26 @@ pub fn run(cmd: MapCommand) -> Result<ExitCode> {
             if !(-0.9..0.95).contains(&overlap) {
                 bail!("--overlap {overlap}: must lie in [-0.9, 0.95)");
             }
+            for out in [&a, &b] {
+                paths::check_extension(out, "output", &["yaml", "yml"])?;
+            }
+            paths::check_outputs(&[&a, &b], &[&map])?;
             let grid = load_map(&map, 0.05)?;
+            let (free, occupied, _) = grid.state_counts();
+            if free + occupied < MIN_KNOWN_TO_CUT {
+                bail!(
+                    "{}: {} known cells ({}x{} map): too few to cut into a pair (need at least {MIN_KNOWN_TO_CUT})",
+                    map.display(),
+                    free + occupied,
+                    grid.width(),
+                    grid.height()
+                );
+            }
             let spec = PairSpec { overlap, max_shift_m: max_shift, rotate: true };
             let pair = cut_pair(&grid, &spec, seed);
+            if overlap > 0.0 && pair.overlap == 0.0 {
+                bail!("{}: the halves share no known cell although --overlap is {overlap}", map.display());
+            }
             map_io::write_ros_map(&pair.a, &a)?;
             map_io::write_ros_map(&pair.b, &b)?;
             let (x, y, th) = pose_xyt(&pair.t_a_b);
@@ -88,7 +116,7 @@ pub fn run(cmd: MapCommand) -> Result<ExitCode> {
 /// Loads a map from a YAML file, or from a bare image at the given resolution.
 pub fn load_map(path: &Path, resolution: f64) -> Result<OccupancyGrid> {
     match extension(path).as_str() {
-        "yaml" | "yml" => Ok(map_io::read_ros_map(path)?),
+        "yaml" | "yml" => read_yaml_map(path),
         "pgm" | "png" => {
             let img = map_io::read_grey_image(path)?;
             let meta = MapYaml {
@@ -118,10 +146,6 @@ pub fn save_map(grid: &OccupancyGrid, path: &Path) -> Result<()> {
         other => bail!("{}: unknown output format `.{other}` (expected .yaml, .pgm or .png)", path.display()),
     }
     Ok(())
-}
-
-fn extension(path: &Path) -> String {
-    path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase()
 }
 
 /// The human summary `map info` prints.

@@ -34,8 +34,8 @@ pub struct MergeArgs {
     /// Transform model: rigid, similarity or homography (the paper's; its rigid part is used).
     #[arg(long, default_value = "rigid")]
     pub model: Model,
-    /// Lowe's ratio for descriptor matching.
-    #[arg(long, default_value_t = 0.75)]
+    /// Lowe's ratio for descriptor matching, in (0, 1].
+    #[arg(long, default_value_t = 0.75, value_parser = ratio)]
     pub ratio: f32,
     /// Keep only mutual nearest-neighbour matches.
     #[arg(long)]
@@ -69,6 +69,15 @@ pub struct MergeArgs {
     pub viz: super::viz::VizArgs,
 }
 
+/// Reads `--ratio`: a number in (0, 1] (a ratio above 1 accepts every match).
+fn ratio(s: &str) -> Result<f32, String> {
+    match s.parse::<f32>() {
+        Ok(r) if r > 0.0 && r <= 1.0 => Ok(r),
+        Ok(r) => Err(format!("{r} is outside (0, 1]")),
+        Err(e) => Err(e.to_string()),
+    }
+}
+
 /// Reads `--algorithm`: a name of [`Algorithm::ALL`], each listed in `--help`.
 fn algorithm_parser() -> impl TypedValueParser<Value = Algorithm> {
     PossibleValuesParser::new(Algorithm::ALL.map(Algorithm::name)).try_map(|s| s.parse::<Algorithm>())
@@ -76,11 +85,21 @@ fn algorithm_parser() -> impl TypedValueParser<Value = Algorithm> {
 
 /// Runs `mrslam merge`.
 pub fn run(args: MergeArgs) -> Result<ExitCode> {
-    for p in [&args.output, &args.report, &args.matches_png].into_iter().flatten() {
-        super::check_output(p)?;
+    let kinds: [(&Option<PathBuf>, &str, &[&str]); 4] = [
+        (&args.output, "--output", &["yaml", "yml"]),
+        (&args.report, "--report", &["json"]),
+        (&args.matches_png, "--matches-png", &["png"]),
+        (&args.viz.rrd, "--rrd", &["rrd"]),
+    ];
+    for (path, flag, allowed) in kinds {
+        if let Some(p) = path {
+            super::paths::check_extension(p, flag, allowed)?;
+        }
     }
-    let a = map_io::read_ros_map(&args.a)?;
-    let b = map_io::read_ros_map(&args.b)?;
+    let outputs: Vec<&Path> = kinds.iter().filter_map(|(p, ..)| p.as_deref()).collect();
+    super::paths::check_outputs(&outputs, &[&args.a, &args.b])?;
+    let a = super::map::read_yaml_map(&args.a)?;
+    let b = super::map::read_yaml_map(&args.b)?;
     let (name_a, name_b) = pair_names(&args.a, &args.b);
     let recording_id = format!("merge-{name_a}-{name_b}-{}-seed{}", args.algorithm, args.seed);
     let mut viz = args.viz.open(&recording_id, &format!("merge {name_a} + {name_b} ({})", args.algorithm))?;

@@ -8,7 +8,7 @@ use mrslam_testbed::runner::{RunOptions, run as run_scenario, write_outputs};
 use mrslam_testbed::scenario::Scenario;
 use mrslam_viz::RunRecorder;
 use std::io::IsTerminal;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 /// Arguments of `mrslam run`.
@@ -35,6 +35,13 @@ pub struct RunArgs {
 
 /// Runs `mrslam run`.
 pub fn run(args: RunArgs) -> Result<ExitCode> {
+    if let Some(rrd) = &args.viz.rrd {
+        // A folder or a missing folder is reported when the recording opens.
+        if !rrd.is_dir() {
+            super::paths::check_extension(rrd, "--rrd", &["rrd"])?;
+        }
+        super::paths::check_not_input(rrd, &[&args.scenario])?;
+    }
     let mut scenario = Scenario::from_file(&args.scenario)?;
     if let Some(s) = args.seed {
         scenario.seed = s;
@@ -60,22 +67,25 @@ pub fn run(args: RunArgs) -> Result<ExitCode> {
         bar.set_draw_target(ProgressDrawTarget::hidden());
     }
     bar.set_style(
-        ProgressStyle::with_template("{msg} [{bar:40}] {prefix} sim s, {elapsed} wall")
+        ProgressStyle::with_template("{msg} [{bar:40}] {prefix} sim s, {elapsed} wall, ETA {eta}")
             .expect("valid template")
             .progress_chars("=> "),
     );
     bar.set_message(scenario.name.clone());
     let opts = RunOptions {
         algorithms,
-        progress: Some(Box::new(|t: f64, _d: f64| {
+        // The bar runs to the expected end of the run (a rendezvous usually comes long before the duration).
+        progress: Some(Box::new(|t: f64, end: f64| {
+            bar.set_length((end.max(t) * 10.0) as u64);
             bar.set_position((t * 10.0) as u64);
-            bar.set_prefix(format!("{t:.0}"));
+            bar.set_prefix(format!("{t:.0}/{end:.0}"));
         })),
         viz: viz.as_mut(),
     };
     let out = run_scenario(&scenario, opts)?;
     bar.finish_and_clear();
     write_outputs(&out, &out_dir)?;
+    remove_stale_recordings(&out_dir, args.viz.rrd.as_deref())?;
     print!("{}", out.report.summary());
     println!("outputs:  {}", out_dir.display());
     if let Some(v) = viz {
@@ -83,4 +93,21 @@ pub fn run(args: RunArgs) -> Result<ExitCode> {
         println!("rerun:    {} ({} rows in {} chunks)", args.viz.describe(), stats.rows, stats.chunks);
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// Removes the `.rrd` recordings an earlier run left in `dir`, keeping this run's (`keep`): a folder's
+/// recording always shows the run whose report and maps sit beside it.
+fn remove_stale_recordings(dir: &Path, keep: Option<&Path>) -> Result<()> {
+    let keep = keep.and_then(|k| k.canonicalize().ok());
+    let entries = std::fs::read_dir(dir).map_err(|e| anyhow::anyhow!("{}: {e}", dir.display()))?;
+    for entry in entries.flatten() {
+        let path = entry.path();
+        let is_rrd = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("rrd")) && path.is_file();
+        if is_rrd && path.canonicalize().ok() != keep {
+            std::fs::remove_file(&path)
+                .map_err(|e| anyhow::anyhow!("{}: cannot remove a stale recording: {e}", path.display()))?;
+            println!("removed:  {} (the recording of an earlier run)", path.display());
+        }
+    }
+    Ok(())
 }

@@ -4,12 +4,14 @@
 use anyhow::{Context, Result, bail};
 use clap::{Args, Subcommand};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use mrslam_core::map_io::read_ros_map;
 use mrslam_merge::floorplan::FloorplanParams;
+use mrslam_testbed::study::journal::{collect_params, fingerprint};
+use mrslam_testbed::study::results::sort_rows;
 use mrslam_testbed::study::{
-    self, MapSource, OverlapStudy, Shard, Sweep, TrialRow, collect, parse_range, run_overlap_study, run_sweep,
-    summary::table,
+    self, Journal, MapSource, OverlapStudy, Progress, Shard, StudyError, StudyParams, Sweep, TrialRow, collect,
+    parse_range, run_overlap_study, run_sweep, summary::table,
 };
+use std::collections::BTreeSet;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -75,6 +77,9 @@ pub struct OverlapArgs {
     /// No progress bar.
     #[arg(long)]
     pub quiet: bool,
+    /// Continue the interrupted study in --out: run only the trials its results.csv lacks.
+    #[arg(long)]
+    pub resume: bool,
 }
 
 /// Arguments of `mrslam study scenario`.
@@ -94,6 +99,9 @@ pub struct ScenarioArgs {
     /// Read and check the sweep, list its trials, run nothing.
     #[arg(long)]
     pub dry_run: bool,
+    /// Continue the interrupted study in --out: run only the trials its results.csv lacks.
+    #[arg(long)]
+    pub resume: bool,
 }
 
 /// Arguments of `mrslam study collect`.
@@ -141,13 +149,72 @@ fn create_out(dir: &Path) -> Result<()> {
     std::fs::create_dir_all(dir).with_context(|| format!("{}: cannot create output folder", dir.display()))
 }
 
+/// A running study's progress: the trials done before a resume are skipped; each finished trial's rows are
+/// appended to results.csv at once, so an interruption loses no finished trial.
+struct Recorder {
+    journal: Journal,
+    done: BTreeSet<usize>,
+    bar: ProgressBar,
+}
+
+impl Progress for Recorder {
+    fn skip(&self, trial: usize) -> bool {
+        self.done.contains(&trial)
+    }
+
+    fn finished(&self, rows: &[TrialRow]) -> Result<(), StudyError> {
+        self.journal.append(rows)?;
+        self.bar.inc(1);
+        Ok(())
+    }
+}
+
+/// Opens the study folder (fresh or resumed) and says what a resume found.
+fn open_study(
+    out: &Path,
+    params: &StudyParams,
+    rows_per_trial: usize,
+    resume: bool,
+) -> Result<(Journal, Vec<TrialRow>)> {
+    create_out(out)?;
+    let (journal, earlier) = Journal::open(out, params, rows_per_trial, resume)?;
+    if resume {
+        let trials: BTreeSet<usize> = earlier.iter().map(|r| r.trial).collect();
+        println!("resuming {}: {} trials already done", out.display(), trials.len());
+    }
+    Ok((journal, earlier))
+}
+
+/// Runs the trials not yet done, then joins the rows with those of before the resume.
+fn run_study(
+    earlier: Vec<TrialRow>,
+    journal: Journal,
+    selected: &[usize],
+    algorithms: &[String],
+    quiet: bool,
+    what: &str,
+    run: impl FnOnce(&Recorder) -> Result<Vec<TrialRow>, StudyError>,
+) -> Result<(Vec<TrialRow>, usize, f64)> {
+    let done: BTreeSet<usize> = earlier.iter().map(|r| r.trial).collect();
+    let n = selected.iter().filter(|t| !done.contains(t)).count();
+    let recorder = Recorder { journal, done, bar: progress_bar(n, quiet, what) };
+    let start = Instant::now();
+    let new = run(&recorder)?;
+    let seconds = start.elapsed().as_secs_f64();
+    recorder.bar.finish_and_clear();
+    let mut rows = earlier;
+    rows.extend(new);
+    sort_rows(&mut rows, algorithms);
+    Ok((rows, n, seconds))
+}
+
 fn finish(rows: &[TrialRow], out: &Path, trials: usize, seconds: Option<f64>) -> Result<ExitCode> {
     let summary = study::write_outputs(rows, out)?;
     print!("{}", table(&summary));
     if let Some(s) = seconds {
         println!("{trials} trials ({} rows) in {s:.1} s: {:.2} trials/s", rows.len(), trials as f64 / s.max(1e-9));
     }
-    println!("outputs:  {} (results.csv, summary.csv, plot.png)", out.display());
+    println!("outputs:  {} (study.json, results.csv, summary.csv, plot.png)", out.display());
     Ok(ExitCode::SUCCESS)
 }
 
@@ -167,15 +234,22 @@ fn overlap(a: OverlapArgs) -> Result<ExitCode> {
     if !(a.resolution > 0.0 && a.resolution.is_finite()) {
         bail!("--resolution must be positive, got {}", a.resolution);
     }
+    let mut params = StudyParams::default();
+    params.set("kind", "overlap");
     let source = if let Some(path) = &a.map {
-        MapSource::Map(read_ros_map(path).with_context(|| format!("--map {}", path.display()))?)
+        let grid = super::map::read_yaml_map(path).with_context(|| format!("--map {}", path.display()))?;
+        params.set("map", fingerprint(&grid_bytes(&grid)));
+        MapSource::Map(grid)
     } else if let Some(path) = &a.world {
-        MapSource::Map(study::overlap::world_truth(path, a.resolution).context("--world")?)
+        let grid = study::overlap::world_truth(path, a.resolution).context("--world")?;
+        params.set("world", fingerprint(&grid_bytes(&grid)));
+        MapSource::Map(grid)
     } else {
         let (w, h) = floorplan_size(&a.floorplan_size)?;
-        let params =
-            FloorplanParams { width_m: w, height_m: h, resolution: a.resolution, ..FloorplanParams::default() };
-        MapSource::Floorplans { count: a.floorplans.unwrap_or(1), params }
+        let count = a.floorplans.unwrap_or(1);
+        params.set("floorplans", format!("{count} of {w}x{h} m"));
+        let fp = FloorplanParams { width_m: w, height_m: h, resolution: a.resolution, ..FloorplanParams::default() };
+        MapSource::Floorplans { count, params: fp }
     };
     let study = OverlapStudy {
         source,
@@ -189,14 +263,33 @@ fn overlap(a: OverlapArgs) -> Result<ExitCode> {
         shard,
     };
     study.validate()?;
-    create_out(&a.out)?;
-    let n = study.selected_trials().len();
-    let bar = progress_bar(n, a.quiet, "overlap study");
-    let start = Instant::now();
-    let rows = run_overlap_study(&study, &|| bar.inc(1))?;
-    let seconds = start.elapsed().as_secs_f64();
-    bar.finish_and_clear();
+    let overlaps: Vec<String> = study.overlaps.iter().map(|o| o.to_string()).collect();
+    let algorithms: Vec<String> = study.algorithms.iter().map(|x| x.name().to_string()).collect();
+    params
+        .set("resolution", a.resolution)
+        .set("overlaps", overlaps.join(","))
+        .set("trials", a.trials)
+        .set("algorithms", algorithms.join(","))
+        .set("seed", a.seed)
+        .set("max_rotation_deg", a.max_rotation_deg)
+        .set("max_translation_cells", a.max_translation_cells)
+        .set("max_shift", a.max_shift);
+    let (journal, earlier) = open_study(&a.out, &params, algorithms.len(), a.resume)?;
+    let selected: Vec<usize> = study.selected_trials().iter().map(|t| t.trial).collect();
+    let (rows, n, seconds) = run_study(earlier, journal, &selected, &algorithms, a.quiet, "overlap study", |p| {
+        run_overlap_study(&study, p)
+    })?;
     finish(&rows, &a.out, n, Some(seconds))
+}
+
+/// A grid's size, resolution, origin and cells as bytes, for its fingerprint.
+fn grid_bytes(g: &mrslam_core::OccupancyGrid) -> Vec<u8> {
+    let (x, y, t) = mrslam_core::pose_xyt(g.origin());
+    let mut b = format!("{} {} {} {x} {y} {t}\n", g.width(), g.height(), g.resolution()).into_bytes();
+    for c in g.cells() {
+        b.extend_from_slice(&c.to_bits().to_le_bytes());
+    }
+    b
 }
 
 fn scenario(a: ScenarioArgs) -> Result<ExitCode> {
@@ -220,19 +313,40 @@ fn scenario(a: ScenarioArgs) -> Result<ExitCode> {
         }
         return Ok(ExitCode::SUCCESS);
     }
-    create_out(&a.out)?;
-    let n = (0..sweep.trials()).filter(|t| shard.selects(*t)).count();
-    let bar = progress_bar(n, a.quiet, &sweep.scenario.name);
-    let start = Instant::now();
-    let rows = run_sweep(&sweep, shard, &|| bar.inc(1))?;
-    let seconds = start.elapsed().as_secs_f64();
-    bar.finish_and_clear();
+    let mut params = StudyParams::default();
+    params.set("kind", "scenario");
+    for (name, path) in
+        [("sweep", &sweep.path), ("scenario", &sweep.scenario.path), ("world", &sweep.scenario.world_path)]
+    {
+        let bytes = std::fs::read(path).with_context(|| format!("{}", path.display()))?;
+        params.set(
+            name,
+            format!("{} {}", path.file_name().map(|f| f.to_string_lossy()).unwrap_or_default(), fingerprint(&bytes)),
+        );
+    }
+    let algorithms: Vec<String> = sweep.algorithms.iter().map(|x| x.name().to_string()).collect();
+    params.set("algorithms", algorithms.join(","));
+    params.set("seeds", sweep.seeds.iter().map(u64::to_string).collect::<Vec<_>>().join(","));
+    let (journal, earlier) = open_study(&a.out, &params, algorithms.len(), a.resume)?;
+    let selected: Vec<usize> = (0..sweep.trials()).filter(|t| shard.selects(*t)).collect();
+    let (rows, n, seconds) = run_study(earlier, journal, &selected, &algorithms, a.quiet, &sweep.scenario.name, |p| {
+        run_sweep(&sweep, shard, p)
+    })?;
     finish(&rows, &a.out, n, Some(seconds))
 }
 
 fn collect_cmd(a: CollectArgs) -> Result<ExitCode> {
+    for d in &a.dirs {
+        if d.canonicalize().ok().is_some_and(|c| a.out.canonicalize().ok() == Some(c)) {
+            bail!("--out {}: is one of the shard folders; its results.csv would be overwritten", a.out.display());
+        }
+    }
+    let params = collect_params(&a.dirs)?;
     let rows = collect(&a.dirs)?;
     create_out(&a.out)?;
+    if let Some(p) = &params {
+        p.write(&a.out)?;
+    }
     let mut trials: Vec<usize> = rows.iter().map(|r| r.trial).collect();
     trials.dedup();
     println!("collected {} rows ({} trials) from {} shard folders", rows.len(), trials.len(), a.dirs.len());

@@ -211,6 +211,14 @@ pub enum CarmenError {
         /// Underlying error.
         cause: std::io::Error,
     },
+    /// A compressed log ends before its stream does.
+    #[error("{path}: cut off after line {line}: the gzip stream ends early (a truncated download or copy?)")]
+    Truncated {
+        /// File at fault.
+        path: PathBuf,
+        /// Last complete line.
+        line: usize,
+    },
     /// A line of a known kind is malformed.
     #[error("{path}:{line}: {kind}: {message}")]
     Line {
@@ -277,7 +285,11 @@ impl CarmenLog {
         let mut odometry: Vec<(Odometry, f64)> = Vec::new();
         for (i, line) in reader.lines().enumerate() {
             let line_no = i + 1;
-            let line = line.map_err(|cause| CarmenError::Io { path: path.to_path_buf(), cause })?;
+            let line = line.map_err(|cause| match cause.kind() {
+                // A gzip stream that ends before its end marker: a truncated file.
+                std::io::ErrorKind::UnexpectedEof => CarmenError::Truncated { path: path.to_path_buf(), line: i },
+                _ => CarmenError::Io { path: path.to_path_buf(), cause },
+            })?;
             let mut fields = line.split_whitespace();
             let Some(kind) = fields.next() else { continue };
             let rest: Vec<&str> = fields.collect();
@@ -604,6 +616,23 @@ ODOM 0.0 0.0 0.0 0.0 0.0 0.0 1.0 host 1.0
         assert_eq!(CarmenLog::read(&p).unwrap().scans.len(), 3);
         let e = CarmenLog::read(&dir.path().join("missing.log")).unwrap_err().to_string();
         assert!(e.contains("missing.log"), "{e}");
+    }
+
+    #[test]
+    fn a_truncated_gzip_is_refused() {
+        use std::io::Write;
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("log.gz");
+        let mut enc = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::fast());
+        for _ in 0..200 {
+            enc.write_all(LOG.as_bytes()).unwrap();
+        }
+        let bytes = enc.finish().unwrap();
+        for cut in [bytes.len() - 4, bytes.len() - 8, bytes.len() / 2, 12] {
+            std::fs::write(&p, &bytes[..cut]).unwrap();
+            let e = CarmenLog::read(&p).unwrap_err().to_string();
+            assert!(e.contains("log.gz") && e.contains("cut off"), "cut at {cut}: {e}");
+        }
     }
 
     /// An ODOM stream at 10 Hz moving 1 m/s along x and turning 0.1 rad/s, and FLASER lines at 5 Hz whose

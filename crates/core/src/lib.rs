@@ -6,11 +6,13 @@
 
 pub mod carmen;
 pub mod grid;
+pub mod input;
 pub mod map_io;
 pub mod pose;
 pub mod raycast;
 pub mod relations;
 pub mod scan;
+pub mod toml_lines;
 
 pub use carmen::{CarmenError, CarmenLog, LaserSource, OdometrySource, ReadOptions, Repairs, ScanRecord};
 pub use grid::{CellState, GridError, LogOddsParams, OccupancyGrid};

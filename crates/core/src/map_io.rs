@@ -6,8 +6,9 @@
 //! pixel value itself as the ROS occupancy (0..100, anything else unknown). Occupancies become log-odds
 //! clamped to ±[`ROS_LOGODDS_LIMIT`], so a map read back from disk holds exactly −2, 0 or +2 per cell.
 //!
-//! The YAML reader handles the flat subset map_server files use: `key: value` lines, `#` comments and a
-//! flow list for `origin`. Errors name the file, the line and the field.
+//! The YAML is read with a YAML parser, so everything map_server accepts is accepted (block or flow lists,
+//! quoted values, comments); keys map_server ignores are reported as warnings. Errors name the file, the line
+//! and the field.
 
 use crate::grid::{CellState, GridError, MAX_CELLS, OccupancyGrid};
 use crate::pose::{Pose2, pose};
@@ -67,7 +68,7 @@ pub enum MapIoError {
         cause: std::io::Error,
     },
     /// A YAML line could not be understood.
-    #[error("{path}:{line}: {message}")]
+    #[error("{}: {message}", at(path, *line))]
     Yaml {
         /// File at fault.
         path: PathBuf,
@@ -77,7 +78,7 @@ pub enum MapIoError {
         message: String,
     },
     /// A field has a value that is not allowed.
-    #[error("{path}:{line}: field `{field}`: {message}")]
+    #[error("{}: field `{field}`: {message}", at(path, *line))]
     BadField {
         /// File at fault.
         path: PathBuf,
@@ -122,6 +123,16 @@ pub enum MapIoError {
         /// Height claimed.
         height: usize,
     },
+    /// The image a map YAML names could not be read.
+    #[error("{}: field `image`: {cause}", at(yaml, *line))]
+    ImageOf {
+        /// The YAML naming the image.
+        yaml: PathBuf,
+        /// Line of its `image` field.
+        line: usize,
+        /// Why the image could not be read (names the image).
+        cause: Box<MapIoError>,
+    },
     /// The grid could not be built.
     #[error("{path}: {cause}")]
     Grid {
@@ -130,6 +141,11 @@ pub enum MapIoError {
         /// Underlying error.
         cause: GridError,
     },
+}
+
+/// `file:line`, or the file alone when the line is not known (0).
+fn at(path: &Path, line: usize) -> String {
+    if line == 0 { path.display().to_string() } else { format!("{}:{line}", path.display()) }
 }
 
 fn io_err(path: &Path) -> impl FnOnce(std::io::Error) -> MapIoError + '_ {
@@ -149,10 +165,19 @@ pub struct GreyImage {
 
 /// Reads a map_server YAML file and the image it names.
 pub fn read_ros_map(yaml_path: &Path) -> Result<OccupancyGrid, MapIoError> {
-    let text = std::fs::read_to_string(yaml_path).map_err(io_err(yaml_path))?;
-    let meta = parse_map_yaml(&text, yaml_path)?;
+    read_ros_map_with(yaml_path, &mut |_| {})
+}
+
+/// Reads a map_server YAML file and the image it names, calling `warn` for each key map_server ignores.
+pub fn read_ros_map_with(yaml_path: &Path, warn: &mut dyn FnMut(String)) -> Result<OccupancyGrid, MapIoError> {
+    let text = crate::input::read_text_limited(yaml_path, crate::input::CONFIG_LIMIT).map_err(io_err(yaml_path))?;
+    let meta = parse_map_yaml_with(&text, yaml_path, warn)?;
     let image_path = resolve_image_path(yaml_path, &meta.image);
-    let img = read_grey_image(&image_path)?;
+    let img = read_grey_image(&image_path).map_err(|cause| MapIoError::ImageOf {
+        yaml: yaml_path.to_path_buf(),
+        line: key_line(&text, "image"),
+        cause: Box::new(cause),
+    })?;
     grid_from_image(&img, &meta).map_err(|cause| MapIoError::Grid { path: yaml_path.to_path_buf(), cause })
 }
 
@@ -211,121 +236,165 @@ pub fn ros_to_log_odds(v: i32) -> f32 {
     }
 }
 
+/// The keys map_server reads from a map YAML.
+pub const MAP_YAML_KEYS: &[&str] =
+    &["image", "resolution", "origin", "negate", "occupied_thresh", "free_thresh", "mode"];
+
 /// Parses the text of a map_server YAML file; `path` only names the file in errors.
 pub fn parse_map_yaml(text: &str, path: &Path) -> Result<MapYaml, MapIoError> {
+    parse_map_yaml_with(text, path, &mut |_| {})
+}
+
+/// The 1-based line where top-level `key` is written (`key:` at the start of a line, quoted or not; 0 when
+/// not found, as in a one-line flow mapping).
+fn key_line(text: &str, key: &str) -> usize {
+    key_lines(text, key).next().unwrap_or(0)
+}
+
+/// Every 1-based line where top-level `key` is written.
+fn key_lines<'t>(text: &'t str, key: &'t str) -> impl Iterator<Item = usize> + 't {
+    let spellings = [key.to_string(), format!("\"{key}\""), format!("'{key}'")];
+    text.lines().enumerate().filter_map(move |(i, l)| {
+        spellings
+            .iter()
+            .any(|k| l.strip_prefix(k.as_str()).is_some_and(|rest| rest.trim_start().starts_with(':')))
+            .then_some(i + 1)
+    })
+}
+
+/// A scalar as text: strings as they are, numbers and booleans as YAML writes them.
+fn scalar_text(v: &serde_norway::Value) -> Option<String> {
+    match v {
+        serde_norway::Value::String(s) => Some(s.clone()),
+        serde_norway::Value::Number(n) => Some(n.to_string()),
+        serde_norway::Value::Bool(b) => Some(b.to_string()),
+        _ => None,
+    }
+}
+
+/// Parses a map YAML as map_server does (any YAML: block or flow lists, quoted scalars, comments), calling
+/// `warn` with a message for each key map_server would ignore.
+pub fn parse_map_yaml_with(text: &str, path: &Path, warn: &mut dyn FnMut(String)) -> Result<MapYaml, MapIoError> {
     let yaml_err = |line: usize, message: String| MapIoError::Yaml { path: path.to_path_buf(), line, message };
-    let bad = |line: usize, field: &'static str, message: String| MapIoError::BadField {
-        path: path.to_path_buf(),
-        line,
-        field,
-        message,
+    let doc: serde_norway::Value = serde_norway::from_str(text).map_err(|e| {
+        let message = e.to_string();
+        // A key given twice: the line of its second appearance.
+        let twice = message
+            .strip_prefix("duplicate entry with key \"")
+            .and_then(|rest| rest.split('"').next())
+            .and_then(|key| key_lines(text, key).nth(1));
+        let line = twice.or(e.location().map(|l| l.line())).unwrap_or(0);
+        // serde_norway appends " at line L column C"; the line is already in front.
+        let message = message.split(" at line ").next().unwrap_or(&message).to_string();
+        yaml_err(line, message)
+    })?;
+    let map = match &doc {
+        serde_norway::Value::Mapping(m) => m,
+        serde_norway::Value::Null => return Err(MapIoError::MissingField { path: path.to_path_buf(), field: "image" }),
+        _ => {
+            let first = text.lines().position(|l| !l.trim().is_empty() && !l.trim_start().starts_with('#'));
+            return Err(yaml_err(first.map_or(1, |i| i + 1), "expected `key: value` lines (a mapping)".into()));
+        }
     };
     let mut image: Option<String> = None;
-    let mut resolution: Option<(usize, f64)> = None;
+    let mut resolution: Option<f64> = None;
     let mut origin: Option<[f64; 3]> = None;
     let mut negate = false;
     let mut occupied_thresh = 0.65;
     let mut free_thresh = 0.196;
-    let mut thresh_line = 0;
     let mut mode = MapMode::Trinary;
-    let mut seen: Vec<String> = Vec::new();
-    for (i, raw) in text.lines().enumerate() {
-        let line_no = i + 1;
-        let line = strip_comment(raw).trim();
-        if line.is_empty() || line == "---" {
-            continue;
-        }
-        let Some((key, value)) = line.split_once(':') else {
-            return Err(yaml_err(line_no, format!("expected `key: value`, found `{line}`")));
+    for (k, v) in map {
+        let Some(key) = k.as_str() else {
+            return Err(yaml_err(0, format!("key `{}` is not a name", scalar_text(k).unwrap_or_else(|| "?".into()))));
         };
-        let key = key.trim();
-        let value = unquote(value.trim());
-        if seen.iter().any(|k| k == key) {
-            return Err(yaml_err(line_no, format!("field `{key}` appears twice")));
-        }
-        seen.push(key.to_string());
+        let line = key_line(text, key);
+        let bad = |field: &'static str, message: String| MapIoError::BadField {
+            path: path.to_path_buf(),
+            line,
+            field,
+            message,
+        };
+        let shown = || scalar_text(v).unwrap_or_else(|| "a list or mapping".into());
         let number = |field: &'static str| -> Result<f64, MapIoError> {
-            value
-                .parse::<f64>()
-                .ok()
+            scalar_text(v)
+                .and_then(|s| s.trim().parse::<f64>().ok())
                 .filter(|v| v.is_finite())
-                .ok_or_else(|| bad(line_no, field, format!("expected a finite number, found `{value}`")))
+                .ok_or_else(|| bad(field, format!("expected a finite number, found `{}`", shown())))
         };
         match key {
             "image" => {
-                if value.is_empty() {
-                    return Err(bad(line_no, "image", "empty image path".into()));
+                let s = scalar_text(v).ok_or_else(|| bad("image", "expected a file name".into()))?;
+                if s.trim().is_empty() {
+                    return Err(bad("image", "empty image path".into()));
                 }
-                image = Some(value.to_string());
+                image = Some(s);
             }
             "resolution" => {
                 let r = number("resolution")?;
                 if r <= 0.0 {
-                    return Err(bad(line_no, "resolution", format!("must be positive, found {r}")));
+                    return Err(bad("resolution", format!("must be positive, found {r}")));
                 }
-                resolution = Some((line_no, r));
+                resolution = Some(r);
             }
             "origin" => {
-                let inner = value
-                    .strip_prefix('[')
-                    .and_then(|v| v.strip_suffix(']'))
-                    .ok_or_else(|| bad(line_no, "origin", format!("expected `[x, y, yaw]`, found `{value}`")))?;
-                let parts: Vec<&str> = inner.split(',').map(str::trim).collect();
-                if parts.len() != 3 {
-                    return Err(bad(line_no, "origin", format!("expected 3 numbers, found {}", parts.len())));
+                let serde_norway::Value::Sequence(items) = v else {
+                    return Err(bad("origin", format!("expected `[x, y, yaw]`, found `{}`", shown())));
+                };
+                if items.len() != 3 {
+                    return Err(bad("origin", format!("expected 3 numbers, found {}", items.len())));
                 }
                 let mut o = [0.0; 3];
-                for (k, p) in parts.iter().enumerate() {
-                    o[k] = p
+                for (slot, item) in o.iter_mut().zip(items) {
+                    let t = scalar_text(item).unwrap_or_else(|| "a list or mapping".into());
+                    *slot = t
+                        .trim()
                         .parse::<f64>()
                         .ok()
                         .filter(|v| v.is_finite())
-                        .ok_or_else(|| bad(line_no, "origin", format!("`{p}` is not a finite number")))?;
+                        .ok_or_else(|| bad("origin", format!("`{t}` is not a finite number")))?;
                 }
                 origin = Some(o);
             }
             "negate" => {
-                negate = match value {
-                    "0" | "false" | "False" => false,
-                    "1" | "true" | "True" => true,
-                    _ => {
-                        return Err(bad(line_no, "negate", format!("expected 0 or 1, found `{value}`")));
-                    }
+                negate = match scalar_text(v).as_deref() {
+                    Some("0" | "false" | "False") => false,
+                    Some("1" | "true" | "True") => true,
+                    _ => return Err(bad("negate", format!("expected 0 or 1, found `{}`", shown()))),
                 }
             }
-            "occupied_thresh" => {
-                occupied_thresh = number("occupied_thresh")?;
-                thresh_line = line_no;
-            }
-            "free_thresh" => {
-                free_thresh = number("free_thresh")?;
-                thresh_line = thresh_line.max(line_no);
-            }
+            "occupied_thresh" => occupied_thresh = number("occupied_thresh")?,
+            "free_thresh" => free_thresh = number("free_thresh")?,
             "mode" => {
-                mode = match value {
-                    "trinary" => MapMode::Trinary,
-                    "scale" => MapMode::Scale,
-                    "raw" => MapMode::Raw,
-                    _ => {
-                        return Err(bad(line_no, "mode", format!("expected trinary, scale or raw, found `{value}`")));
-                    }
+                mode = match scalar_text(v).as_deref() {
+                    Some("trinary") => MapMode::Trinary,
+                    Some("scale") => MapMode::Scale,
+                    Some("raw") => MapMode::Raw,
+                    _ => return Err(bad("mode", format!("expected trinary, scale or raw, found `{}`", shown()))),
                 }
             }
-            _ => {} // map_server ignores fields it does not know; so do we.
+            other => {
+                let at = if line == 0 { String::new() } else { format!(":{line}") };
+                warn(format!(
+                    "{}{at}: unknown key `{other}` ignored (map_server reads {})",
+                    path.display(),
+                    MAP_YAML_KEYS.join(", ")
+                ));
+            }
         }
     }
     if !(0.0..=1.0).contains(&free_thresh) || !(0.0..=1.0).contains(&occupied_thresh) || free_thresh >= occupied_thresh
     {
-        return Err(bad(
-            thresh_line,
-            "free_thresh",
-            format!("need 0 <= free_thresh < occupied_thresh <= 1, found {free_thresh} and {occupied_thresh}"),
-        ));
+        return Err(MapIoError::BadField {
+            path: path.to_path_buf(),
+            line: key_line(text, "free_thresh").max(key_line(text, "occupied_thresh")),
+            field: "free_thresh",
+            message: format!("need 0 <= free_thresh < occupied_thresh <= 1, found {free_thresh} and {occupied_thresh}"),
+        });
     }
     let missing = |field| MapIoError::MissingField { path: path.to_path_buf(), field };
     Ok(MapYaml {
         image: image.ok_or_else(|| missing("image"))?,
-        resolution: resolution.ok_or_else(|| missing("resolution"))?.1,
+        resolution: resolution.ok_or_else(|| missing("resolution"))?,
         origin: origin.ok_or_else(|| missing("origin"))?,
         negate,
         occupied_thresh,
@@ -334,44 +403,27 @@ pub fn parse_map_yaml(text: &str, path: &Path) -> Result<MapYaml, MapIoError> {
     })
 }
 
-fn strip_comment(line: &str) -> &str {
-    let mut in_quote: Option<char> = None;
-    for (i, c) in line.char_indices() {
-        match (c, in_quote) {
-            ('"' | '\'', None) => in_quote = Some(c),
-            (q, Some(open)) if q == open => in_quote = None,
-            ('#', None) if i == 0 || line[..i].ends_with(char::is_whitespace) => return &line[..i],
-            _ => {}
-        }
-    }
-    line
-}
-
-fn unquote(v: &str) -> &str {
-    for q in ['"', '\''] {
-        if let Some(inner) = v.strip_prefix(q).and_then(|s| s.strip_suffix(q)) {
-            return inner;
-        }
-    }
-    v
-}
-
 /// Reads a grey image: PGM (P5 binary or P2 ASCII, any maxval) by our own parser, anything else (PNG) with
 /// the `image` crate. Colour images are averaged to grey as map_server does; dimensions are checked
 /// against [`MAX_CELLS`] before pixels are allocated.
 pub fn read_grey_image(path: &Path) -> Result<GreyImage, MapIoError> {
-    let bytes = std::fs::read(path).map_err(io_err(path))?;
+    let bytes = crate::input::read_limited(path, crate::input::DATA_LIMIT).map_err(io_err(path))?;
+    decode_grey_image(&bytes, path)
+}
+
+/// Decodes a grey image from its bytes (see [`read_grey_image`]); `path` only names it in errors.
+pub fn decode_grey_image(bytes: &[u8], path: &Path) -> Result<GreyImage, MapIoError> {
     if bytes.first() == Some(&b'P') {
-        return parse_pgm(&bytes, path);
+        return parse_pgm(bytes, path);
     }
-    let reader = image::ImageReader::new(std::io::Cursor::new(&bytes)).with_guessed_format().map_err(io_err(path))?;
+    let reader = image::ImageReader::new(std::io::Cursor::new(bytes)).with_guessed_format().map_err(io_err(path))?;
     let (w, h) =
         reader.into_dimensions().map_err(|e| MapIoError::Image { path: path.to_path_buf(), message: e.to_string() })?;
     let (w, h) = (w as usize, h as usize);
     if w.saturating_mul(h) > MAX_CELLS {
         return Err(MapIoError::TooLarge { path: path.to_path_buf(), width: w, height: h });
     }
-    let img = image::ImageReader::new(std::io::Cursor::new(&bytes))
+    let img = image::ImageReader::new(std::io::Cursor::new(bytes))
         .with_guessed_format()
         .map_err(io_err(path))?
         .decode()
@@ -412,27 +464,31 @@ pub fn parse_pgm(bytes: &[u8], path: &Path) -> Result<GreyImage, MapIoError> {
     }
     let n = w * h;
     let scale = |v: usize| -> u8 { ((v.min(maxval) * 255 + maxval / 2) / maxval) as u8 };
-    let mut pixels = Vec::with_capacity(n);
     if binary {
         pos += 1; // exactly one whitespace byte after maxval
         let bpp = if maxval > 255 { 2 } else { 1 };
         let data = bytes.get(pos..).unwrap_or(&[]);
+        // Checked before any allocation: a header may claim any size.
         if data.len() < n * bpp {
             return Err(err(format!("truncated: {} of {} pixel bytes present", data.len(), n * bpp)));
         }
+        let mut pixels = Vec::with_capacity(n);
         if bpp == 1 {
             pixels.extend(data[..n].iter().map(|&v| scale(v as usize)));
         } else {
             pixels.extend(data[..2 * n].chunks_exact(2).map(|c| scale(((c[0] as usize) << 8) | c[1] as usize)));
         }
+        Ok(GreyImage { width: w, height: h, pixels })
     } else {
+        // Each ASCII pixel takes at least a digit and a separator: no more can be present than that allows.
+        let mut pixels = Vec::with_capacity(n.min(bytes.len().saturating_sub(pos) / 2 + 1));
         for k in 0..n {
             let v = next_number(bytes, &mut pos)
                 .ok_or_else(|| err(format!("truncated: pixel {k} of {n} missing or not a number")))?;
             pixels.push(scale(v));
         }
+        Ok(GreyImage { width: w, height: h, pixels })
     }
-    Ok(GreyImage { width: w, height: h, pixels })
 }
 
 /// Reads the next whitespace-separated decimal number, skipping `#` comments.
@@ -676,11 +732,34 @@ mod tests {
     }
 
     #[test]
+    fn any_yaml_map_server_reads_is_read_and_unknown_keys_are_reported() {
+        let block = "image: \"m.pgm\"\nresolution: 0.05\norigin:\n  - -10.0\n  - -10.0\n  - 0.0\nnegate: 0\n";
+        assert_eq!(yaml(block).unwrap().origin, [-10.0, -10.0, 0.0]);
+        let flow = yaml("{image: m.pgm, resolution: '0.1', origin: [1, 2, 3], free_thresh: 0.2}").unwrap();
+        assert_eq!((flow.resolution, flow.free_thresh), (0.1, 0.2));
+        let mut warnings = Vec::new();
+        let m = parse_map_yaml_with(
+            "image: m.pgm\nresolutoin: 0.1\nresolution: 0.05\norigin: [0, 0, 0]\n",
+            Path::new("m.yaml"),
+            &mut |w| warnings.push(w),
+        )
+        .unwrap();
+        assert_eq!(m.resolution, 0.05);
+        assert_eq!(warnings.len(), 1);
+        assert!(warnings[0].starts_with("m.yaml:2: unknown key `resolutoin` ignored"), "{warnings:?}");
+        let e = yaml("image: m.pgm\nimage: n.pgm\n").unwrap_err().to_string();
+        assert!(e.contains("m.yaml:2") && e.contains("duplicate"), "{e}");
+        let e = yaml("image: [m.pgm\n").unwrap_err().to_string();
+        assert!(e.starts_with("m.yaml:"), "{e}");
+        assert!(yaml("").is_err() && yaml("- a\n- b\n").is_err());
+    }
+
+    #[test]
     fn image_errors_name_the_file() {
         let dir = tempfile::tempdir().unwrap();
         let y = write(dir.path(), "m.yaml", b"image: gone.pgm\nresolution: 0.05\norigin: [0, 0, 0]\n");
         let e = read_ros_map(&y).unwrap_err().to_string();
-        assert!(e.contains("gone.pgm"), "{e}");
+        assert!(e.contains("gone.pgm") && e.starts_with(&format!("{}:1: field `image`: ", y.display())), "{e}");
         write(dir.path(), "bad.pgm", b"P6\n1 1\n255\n\0\0\0");
         let e = read_grey_image(&dir.path().join("bad.pgm")).unwrap_err().to_string();
         assert!(e.contains("bad.pgm") && e.contains("P6"), "{e}");

@@ -92,7 +92,8 @@ fn numeric_lines(text: &str, path: &Path, names: &[&str]) -> Result<Vec<(usize, 
 }
 
 fn read_text(path: &Path) -> Result<String, RelationsError> {
-    std::fs::read_to_string(path).map_err(|cause| RelationsError::Io { path: path.to_path_buf(), cause })
+    crate::input::read_text_limited(path, crate::input::DATA_LIMIT)
+        .map_err(|cause| RelationsError::Io { path: path.to_path_buf(), cause })
 }
 
 /// Parses a relations file's text; `path` only names the source in errors.

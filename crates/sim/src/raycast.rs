@@ -50,7 +50,10 @@ impl RayCaster {
         }
         let mut cell = cell.max(1e-3);
         // keep the grid small for huge, sparse worlds
-        while ((hi.x - lo.x) / cell) * ((hi.y - lo.y) / cell) > 4e6 {
+        // Counted as the grid is built (rounded up, plus the margin), so a world long and thin (1e16 m by 1 m)
+        // cannot slip past the bound.
+        let cells = |cell: f64| (((hi.x - lo.x) / cell).ceil() + 2.0) * (((hi.y - lo.y) / cell).ceil() + 2.0);
+        while cells(cell) > 4e6 && cell.is_finite() {
             cell *= 2.0;
         }
         let margin = Vector2::new(cell, cell);

@@ -221,7 +221,8 @@ impl WorldSpec {
     /// Reads, parses and validates a world file (and loads its bitmap layer).
     pub fn from_toml_file(path: impl AsRef<Path>) -> Result<WorldSpec, SimError> {
         let path = path.as_ref();
-        let text = std::fs::read_to_string(path).map_err(|cause| SimError::Io { path: path.to_path_buf(), cause })?;
+        let text = mrslam_core::input::read_text_limited(path, mrslam_core::input::CONFIG_LIMIT)
+            .map_err(|cause| SimError::Io { path: path.to_path_buf(), cause })?;
         Self::from_toml_str(&text, path)
     }
 

@@ -47,6 +47,16 @@ impl PurePursuit {
         self.done
     }
 
+    /// Length of the path still to drive from `p`: to the current waypoint, then along the rest, metres.
+    pub fn remaining(&self, p: &Point2<f64>) -> f64 {
+        if self.done {
+            return 0.0;
+        }
+        let Some(next) = self.path.get(self.segment) else { return 0.0 };
+        let rest: f64 = self.path[self.segment..].windows(2).map(|w| (w[1] - w[0]).norm()).sum();
+        (next - p).norm() + rest
+    }
+
     /// The last waypoint.
     pub fn goal(&self) -> Option<Point2<f64>> {
         self.path.last().copied()

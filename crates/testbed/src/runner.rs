@@ -46,7 +46,8 @@ pub enum RunError {
 pub struct RunOptions<'a> {
     /// Merge algorithms to run instead of the scenario's.
     pub algorithms: Option<Vec<Algorithm>>,
-    /// Called about once per simulated second with (simulated time, duration).
+    /// Called about once per simulated second with (simulated time, expected end of the run): the merge
+    /// time, the duration, or at a rendezvous of routed robots the time their remaining routes take.
     pub progress: Option<Box<dyn FnMut(f64, f64) + 'a>>,
     /// Records the run for the rerun viewer; `None` (the default) records and converts nothing.
     pub viz: Option<&'a mut RunRecorder>,
@@ -223,7 +224,7 @@ pub fn run(scenario: &Scenario, mut opts: RunOptions) -> Result<RunOutput, RunEr
         if let Some(p) = opts.progress.as_mut()
             && t >= next_progress
         {
-            p(t, scenario.duration);
+            p(t, expected_end(scenario, &sim, &agents, t));
             next_progress += 1.0;
         }
         let merge_now = match scenario.merge.when {
@@ -394,6 +395,25 @@ pub fn run(scenario: &Scenario, mut opts: RunOptions) -> Result<RunOutput, RunEr
         observed_overlap: if either == 0 { 0.0 } else { both as f64 / either as f64 },
     };
     Ok(RunOutput { report, maps, truth, merges })
+}
+
+/// When the run is expected to end, simulated seconds: a fixed merge time or the duration; at a rendezvous
+/// of robots on routes, now plus the longest time a robot's remaining route takes at its cruise speed.
+fn expected_end(scenario: &Scenario, sim: &Sim, agents: &[Agent], t: f64) -> f64 {
+    let to_go = |a: &Agent| -> Option<f64> {
+        let p = a.pursuit.as_ref()?;
+        let pose = sim.true_pose(a.id).ok()?;
+        Some(p.remaining(&Point2::from(pose.translation.vector)) / p.speed.max(1e-3))
+    };
+    match scenario.merge.when {
+        MergeWhen::At(m) => m.min(scenario.duration),
+        MergeWhen::End => scenario.duration,
+        MergeWhen::Rendezvous => agents
+            .iter()
+            .map(to_go)
+            .try_fold(0.0f64, |longest, s| s.map(|s| longest.max(s)))
+            .map_or(scenario.duration, |s| (t + s).min(scenario.duration)),
+    }
 }
 
 /// Writes a run's maps (PGM+YAML), the true map, merged maps and `report.json` (last) into `dir`.

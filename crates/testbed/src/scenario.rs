@@ -3,6 +3,7 @@
 //! A scenario is TOML (see `scenarios/paper_corridor.toml`); paths inside it are relative to the file.
 //! Every error names the file, the line and the field at fault.
 
+use mrslam_core::toml_lines::{TomlLines, line_at};
 use mrslam_core::{Pose2, pose};
 use mrslam_merge::{Algorithm, MapEncoding, Model};
 use mrslam_sim::{EncoderParams, LidarModel, RobotModel, SlipParams, World, WorldSpec};
@@ -14,7 +15,7 @@ use std::path::{Path, PathBuf};
 
 /// A scenario error, naming the file, line and field.
 #[derive(Debug, thiserror::Error)]
-#[error("{path}:{line}: {field}: {message}")]
+#[error("{}: {field}: {message}", at(path, *line))]
 pub struct ScenarioError {
     /// File at fault.
     pub path: PathBuf,
@@ -24,6 +25,11 @@ pub struct ScenarioError {
     pub field: String,
     /// What is wrong.
     pub message: String,
+}
+
+/// `file:line`, or the file alone when the problem is not tied to a line.
+pub fn at(path: &Path, line: usize) -> String {
+    if line == 0 { path.display().to_string() } else { format!("{}:{line}", path.display()) }
 }
 
 /// How a robot is driven.
@@ -260,30 +266,17 @@ struct SuccessFile {
     translation_m: Option<f64>,
 }
 
-/// The 1-based line of the first line of `text` containing `needle` (0 when absent).
-fn line_of(text: &str, needle: &str) -> usize {
-    text.lines().position(|l| l.contains(needle)).map_or(0, |i| i + 1)
-}
-
-/// The 1-based line of a byte offset.
-fn line_at(text: &str, offset: usize) -> usize {
-    text[..offset.min(text.len())].matches('\n').count() + 1
-}
-
 struct Ctx<'a> {
     path: &'a Path,
-    text: &'a str,
+    lines: TomlLines<'a>,
 }
 
 impl Ctx<'_> {
-    /// An error on `field`, located at the first line containing `needle`.
-    fn err(&self, field: impl Into<String>, needle: &str, message: impl Into<String>) -> ScenarioError {
-        ScenarioError {
-            path: self.path.to_path_buf(),
-            line: line_of(self.text, needle),
-            field: field.into(),
-            message: message.into(),
-        }
+    /// An error on `field` (a dotted path such as `robots[1].speed`), located at the line where the field is
+    /// written, or where its table is when the field was left out.
+    fn err(&self, field: impl Into<String>, message: impl Into<String>) -> ScenarioError {
+        let field = field.into();
+        ScenarioError { path: self.path.to_path_buf(), line: self.lines.line(&field), field, message: message.into() }
     }
 }
 
@@ -299,18 +292,15 @@ fn apply<T: Copy>(pairs: &mut [(&mut T, Option<T>)]) {
 impl Scenario {
     /// Reads and resolves a scenario file (and the world it names).
     pub fn from_file(path: &Path) -> Result<Scenario, ScenarioError> {
-        let text = std::fs::read_to_string(path).map_err(|e| ScenarioError {
-            path: path.to_path_buf(),
-            line: 0,
-            field: "file".into(),
-            message: e.to_string(),
+        let text = mrslam_core::input::read_text_limited(path, mrslam_core::input::CONFIG_LIMIT).map_err(|e| {
+            ScenarioError { path: path.to_path_buf(), line: 0, field: "file".into(), message: e.to_string() }
         })?;
         Self::parse(&text, path)
     }
 
     /// Resolves a scenario from its text; `path` names it in errors and anchors relative paths.
     pub fn parse(text: &str, path: &Path) -> Result<Scenario, ScenarioError> {
-        let cx = Ctx { path, text };
+        let cx = Ctx { path, lines: TomlLines::new(text) };
         let file: ScenarioFile = toml::from_str(text).map_err(|e| {
             let line = e.span().map_or(0, |s| line_at(text, s.start));
             ScenarioError { path: path.to_path_buf(), line, field: "toml".into(), message: e.message().to_string() }
@@ -318,21 +308,21 @@ impl Scenario {
         let dir = path.parent().unwrap_or(Path::new("."));
         let world_path = dir.join(&file.world);
         let world = WorldSpec::from_toml_file(&world_path)
-            .map_err(|e| cx.err("world", "world", format!("cannot load world `{}`: {e}", file.world)))?;
-        let built = World::from_spec(&world).map_err(|e| cx.err("world", "world", e.to_string()))?;
+            .map_err(|e| cx.err("world", format!("cannot load world `{}`: {e}", file.world)))?;
+        let built = World::from_spec(&world).map_err(|e| cx.err("world", e.to_string()))?;
         if !(file.duration.is_finite() && file.duration > 0.0) {
-            return Err(cx.err("duration", "duration", format!("must be positive, got {}", file.duration)));
+            return Err(cx.err("duration", format!("must be positive, got {}", file.duration)));
         }
         let dt = file.dt.unwrap_or(0.01);
         if !(dt > 0.0 && dt <= 0.1) {
-            return Err(cx.err("dt", "dt", format!("must lie in (0, 0.1] s, got {dt}")));
+            return Err(cx.err("dt", format!("must lie in (0, 0.1] s, got {dt}")));
         }
         let truth_resolution = file.truth_resolution.unwrap_or(0.05);
         if !(truth_resolution > 0.0 && truth_resolution.is_finite()) {
-            return Err(cx.err("truth_resolution", "truth_resolution", "must be positive"));
+            return Err(cx.err("truth_resolution", "must be positive"));
         }
         if file.robots.len() != 2 {
-            return Err(cx.err("robots", "[[robots]]", format!("need two robots, found {}", file.robots.len())));
+            return Err(cx.err("robots", format!("need two robots, found {}", file.robots.len())));
         }
         let robots = file
             .robots
@@ -341,7 +331,20 @@ impl Scenario {
             .map(|(i, r)| resolve_robot(&cx, i, r, &world, &built))
             .collect::<Result<Vec<_>, _>>()?;
         if robots[0].name == robots[1].name {
-            return Err(cx.err("robots[1].name", &robots[1].name, "two robots share this name"));
+            return Err(cx.err("robots[1].name", format!("both robots are named `{}`", robots[1].name)));
+        }
+        let (a, b) = (&robots[0], &robots[1]);
+        let apart = (a.start.translation.vector - b.start.translation.vector).norm();
+        let need = a.model.footprint.bounding_radius() + b.model.footprint.bounding_radius();
+        if apart < need {
+            return Err(cx.err(
+                "robots[1].start",
+                format!(
+                    "robot `{}` would start {apart:.2} m from robot `{}`, so their bodies overlap; starts must lie \
+                     at least {need:.2} m apart",
+                    b.name, a.name
+                ),
+            ));
         }
         let merge = resolve_merge(&cx, &file.merge, &robots, file.duration)?;
         let success = Success {
@@ -372,7 +375,7 @@ impl Scenario {
 fn resolve_pose(cx: &Ctx, field: &str, r: &PoseRef, world: &WorldSpec) -> Result<Pose2, ScenarioError> {
     match r {
         PoseRef::Named(n) => {
-            world.named_pose(n).ok_or_else(|| cx.err(field, n, format!("no point named `{n}` in the world")))
+            world.named_pose(n).ok_or_else(|| cx.err(field, format!("no point named `{n}` in the world")))
         }
         PoseRef::Xyt([x, y, t]) => Ok(pose(*x, *y, *t)),
     }
@@ -389,7 +392,7 @@ fn resolve_robot(
     let model = match r.model.as_str() {
         "experia" => RobotModel::experia(),
         "prawn" => RobotModel::prawn(),
-        m => return Err(cx.err(f("model"), m, format!("unknown robot model `{m}` (expected experia or prawn)"))),
+        m => return Err(cx.err(f("model"), format!("unknown robot model `{m}` (expected experia or prawn)"))),
     };
     let lidar = resolve_lidar(cx, &f("lidar"), &r.lidar)?;
     let mut slip = if r.slip.none == Some(true) { SlipParams::none() } else { SlipParams::default() };
@@ -403,7 +406,7 @@ fn resolve_robot(
         (&mut slip.event_duration, s.event_duration),
         (&mut slip.event_magnitude, s.event_magnitude),
     ]);
-    slip.validate().map_err(|e| cx.err(f("slip"), "slip", e.to_string()))?;
+    slip.validate().map_err(|e| cx.err(f("slip"), e.to_string()))?;
     let mut encoder = EncoderParams::default();
     let e = &r.encoder;
     apply(&mut [(&mut encoder.ticks_per_rev, e.ticks_per_rev)]);
@@ -412,48 +415,42 @@ fn resolve_robot(
         (&mut encoder.right_radius_error, e.right_radius_error),
         (&mut encoder.wheel_base_error, e.wheel_base_error),
     ]);
-    encoder.validate().map_err(|er| cx.err(f("encoder"), "encoder", er.to_string()))?;
+    encoder.validate().map_err(|er| cx.err(f("encoder"), er.to_string()))?;
     let slam = resolve_slam(cx, &f("slam"), &r.slam, &lidar)?;
     let start = resolve_pose(cx, &f("start"), &r.start, spec)?;
-    if world.footprint_collides(&model.footprint, &start) {
+    let (lo, hi) = world.bounds();
+    let outside = |p: &Point2<f64>| !(p.x >= lo.x && p.y >= lo.y && p.x <= hi.x && p.y <= hi.y);
+    let bounds = format!("{:.1}..{:.1} x {:.1}..{:.1}", lo.x, hi.x, lo.y, hi.y);
+    if outside(&Point2::from(start.translation.vector)) {
         let (x, y) = (start.translation.x, start.translation.y);
-        let needle = match &r.start {
-            PoseRef::Named(n) => n.clone(),
-            PoseRef::Xyt(_) => "start".into(),
-        };
         return Err(cx.err(
             f("start"),
-            &needle,
-            format!("robot `{}` would start inside an obstacle at ({x:.2}, {y:.2})", r.name),
+            format!("robot `{}` would start at ({x:.2}, {y:.2}), outside the world ({bounds})", r.name),
         ));
     }
-    let (lo, hi) = world.bounds();
+    if world.footprint_collides(&model.footprint, &start) {
+        let (x, y) = (start.translation.x, start.translation.y);
+        return Err(
+            cx.err(f("start"), format!("robot `{}` would start inside an obstacle at ({x:.2}, {y:.2})", r.name))
+        );
+    }
     let mut route = Vec::new();
     for (k, w) in r.route.iter().enumerate() {
         let field = format!("robots[{i}].route[{k}]");
-        let (p, needle) = match w {
+        let p = match w {
             PointRef::Named(n) => {
-                let p = spec
-                    .named_pose(n)
-                    .ok_or_else(|| cx.err(&field, n, format!("no point named `{n}` in the world")))?;
-                (Point2::new(p.translation.x, p.translation.y), n.clone())
+                let p =
+                    spec.named_pose(n).ok_or_else(|| cx.err(&field, format!("no point named `{n}` in the world")))?;
+                Point2::new(p.translation.x, p.translation.y)
             }
-            PointRef::Xy([x, y]) => (Point2::new(*x, *y), "route".to_string()),
+            PointRef::Xy([x, y]) => Point2::new(*x, *y),
         };
-        if p.x < lo.x || p.y < lo.y || p.x > hi.x || p.y > hi.y {
-            return Err(cx.err(
-                &field,
-                &needle,
-                format!(
-                    "waypoint ({:.2}, {:.2}) lies outside the world ({:.1}..{:.1} x {:.1}..{:.1})",
-                    p.x, p.y, lo.x, hi.x, lo.y, hi.y
-                ),
-            ));
+        if outside(&p) {
+            return Err(cx.err(&field, format!("waypoint ({:.2}, {:.2}) lies outside the world ({bounds})", p.x, p.y)));
         }
         if world.footprint_collides(&model.footprint, &pose(p.x, p.y, 0.0)) {
             return Err(cx.err(
                 &field,
-                &needle,
                 format!("the robot cannot stand at waypoint ({:.2}, {:.2}): it overlaps an obstacle", p.x, p.y),
             ));
         }
@@ -463,27 +460,19 @@ fn resolve_robot(
         "waypoints" => ControllerKind::Waypoints,
         "explore" => ControllerKind::Explore,
         c => {
-            return Err(cx.err(
-                f("controller"),
-                c,
-                format!("unknown controller `{c}` (expected waypoints or explore)"),
-            ));
+            return Err(cx.err(f("controller"), format!("unknown controller `{c}` (expected waypoints or explore)")));
         }
     };
     if controller == ControllerKind::Waypoints && route.is_empty() {
-        return Err(cx.err(f("route"), &r.name, "the waypoint controller needs a route"));
+        return Err(cx.err(f("route"), "the waypoint controller needs a route"));
     }
     let speed = r.speed.unwrap_or(0.4);
     if !(speed > 0.0 && speed <= model.max_speed) {
-        return Err(cx.err(
-            f("speed"),
-            "speed",
-            format!("must lie in (0, {}] m/s for this robot, got {speed}", model.max_speed),
-        ));
+        return Err(cx.err(f("speed"), format!("must lie in (0, {}] m/s for this robot, got {speed}", model.max_speed)));
     }
     let lookahead = r.lookahead.unwrap_or(0.35);
     if !(lookahead > 0.05 && lookahead <= 5.0) {
-        return Err(cx.err(f("lookahead"), "lookahead", format!("must lie in (0.05, 5] m, got {lookahead}")));
+        return Err(cx.err(f("lookahead"), format!("must lie in (0.05, 5] m, got {lookahead}")));
     }
     Ok(RobotSetup {
         name: r.name.clone(),
@@ -504,11 +493,7 @@ fn resolve_lidar(cx: &Ctx, field: &str, r: &LidarRef) -> Result<LidarModel, Scen
     let preset = |name: &str| match name {
         "hokuyo_urg_04lx" => Ok(LidarModel::hokuyo_urg_04lx()),
         "rplidar_a1" => Ok(LidarModel::rplidar_a1()),
-        other => Err(cx.err(
-            field,
-            other,
-            format!("unknown lidar preset `{other}` (expected hokuyo_urg_04lx or rplidar_a1)"),
-        )),
+        other => Err(cx.err(field, format!("unknown lidar preset `{other}` (expected hokuyo_urg_04lx or rplidar_a1)"))),
     };
     let lidar = match r {
         LidarRef::Preset(name) => preset(name)?,
@@ -535,13 +520,13 @@ fn resolve_lidar(cx: &Ctx, field: &str, r: &LidarRef) -> Result<LidarModel, Scen
             l
         }
     };
-    lidar.validate().map_err(|e| cx.err(field, "lidar", e.to_string()))?;
+    lidar.validate().map_err(|e| cx.err(field, e.to_string()))?;
     Ok(lidar)
 }
 
 fn resolve_slam(cx: &Ctx, field: &str, s: &SlamFile, lidar: &LidarModel) -> Result<SlamParams, ScenarioError> {
     let mut p = match s.preset.as_deref() {
-        Some(name) => name.parse::<mrslam_slam::Preset>().map_err(|e| cx.err(field, name, e))?.params(),
+        Some(name) => name.parse::<mrslam_slam::Preset>().map_err(|e| cx.err(field, e))?.params(),
         // Without a preset, the one matching the lidar's reach.
         None if lidar.range_max <= 4.5 => SlamParams::hokuyo(),
         None => SlamParams::rplidar(),
@@ -552,19 +537,17 @@ fn resolve_slam(cx: &Ctx, field: &str, s: &SlamFile, lidar: &LidarModel) -> Resu
             toml::Value::String(t) => t.clone(),
             toml::Value::Integer(_) | toml::Value::Float(_) | toml::Value::Boolean(_) => value.to_string(),
             other => {
-                return Err(cx.err(
-                    format!("{field}.{name}"),
-                    name,
-                    format!("expected a number, boolean or string, got {other}"),
-                ));
+                return Err(
+                    cx.err(format!("{field}.{name}"), format!("expected a number, boolean or string, got {other}"))
+                );
             }
         };
-        p.set(name, &text).map_err(|e| cx.err(format!("{field}.{name}"), name, e))?;
+        p.set(name, &text).map_err(|e| cx.err(format!("{field}.{name}"), e))?;
     }
     // The filter sees no farther than the lidar.
     p.max_range = p.max_range.min(lidar.range_max);
     p.max_urange = p.max_urange.min(lidar.range_max);
-    p.validate().map_err(|e| cx.err(field, "slam", e))?;
+    p.validate().map_err(|e| cx.err(field, e))?;
     Ok(p)
 }
 
@@ -576,55 +559,45 @@ fn resolve_merge(cx: &Ctx, m: &MergeFile, robots: &[RobotSetup], duration: f64) 
         Some(toml::Value::Float(t)) => MergeWhen::At(*t),
         Some(toml::Value::Integer(t)) => MergeWhen::At(*t as f64),
         Some(v) => {
-            return Err(cx.err(
-                "merge.when",
-                "when",
-                format!("expected \"rendezvous\", \"end\" or a time in seconds, got {v}"),
-            ));
+            return Err(cx.err("merge.when", format!("expected \"rendezvous\", \"end\" or a time in seconds, got {v}")));
         }
     };
     if let MergeWhen::At(t) = when {
         if t.is_nan() || t <= 0.0 {
-            return Err(cx.err("merge.when", "when", format!("merge time must be positive, got {t}")));
+            return Err(cx.err("merge.when", format!("merge time must be positive, got {t}")));
         }
         if t > duration {
-            return Err(cx.err(
-                "merge.when",
-                "when",
-                format!("merge time {t} s is after the end of the run ({duration} s)"),
-            ));
+            return Err(cx.err("merge.when", format!("merge time {t} s is after the end of the run ({duration} s)")));
         }
     }
     let algorithms = match &m.algorithms {
         None => vec![Algorithm::Sift],
         Some(names) => names
             .iter()
-            .map(|a| a.parse::<Algorithm>().map_err(|e| cx.err("merge.algorithms", a, e.to_string())))
+            .map(|a| a.parse::<Algorithm>().map_err(|e| cx.err("merge.algorithms", e.to_string())))
             .collect::<Result<_, _>>()?,
     };
     let model = match &m.model {
         None => Model::Rigid,
-        Some(s) => s.parse().map_err(|e: String| cx.err("merge.model", s, e))?,
+        Some(s) => s.parse().map_err(|e: String| cx.err("merge.model", e))?,
     };
     let ratio = m.ratio.unwrap_or(0.75);
     if !(ratio > 0.0 && ratio <= 1.0) {
-        return Err(cx.err("merge.ratio", "ratio", format!("must lie in (0, 1], got {ratio}")));
+        return Err(cx.err("merge.ratio", format!("must lie in (0, 1], got {ratio}")));
     }
     let encoding = match m.encoding.as_deref() {
         None | Some("walls") => MapEncoding::WALLS,
         Some("paper") => MapEncoding::PAPER,
         Some(e) => {
-            return Err(cx.err("merge.encoding", e, format!("unknown encoding `{e}` (expected walls or paper)")));
+            return Err(cx.err("merge.encoding", format!("unknown encoding `{e}` (expected walls or paper)")));
         }
     };
     let host = m.host.clone().unwrap_or_else(|| robots[0].name.clone());
     if !robots.iter().any(|r| r.name == host) {
-        return Err(cx.err("merge.host", &host, format!("no robot named `{host}`")));
+        return Err(cx.err("merge.host", format!("no robot named `{host}`")));
     }
     let in_range = |field: &str, v: Option<usize>, lo: usize, hi: usize, default: usize| match v {
-        Some(x) if !(lo..=hi).contains(&x) => {
-            Err(cx.err(field, field.trim_start_matches("merge."), format!("must lie in {lo}..={hi}, got {x}")))
-        }
+        Some(x) if !(lo..=hi).contains(&x) => Err(cx.err(field, format!("must lie in {lo}..={hi}, got {x}"))),
         v => Ok(v.unwrap_or(default)),
     };
     let candidates = in_range("merge.candidates", m.candidates, 1, 16, 1)?;
@@ -638,7 +611,7 @@ mod tests {
     use super::*;
 
     /// `paper_two_rooms.toml` with `edit` applied to its text, resolved as if it lay beside the original.
-    fn two_rooms(edit: impl Fn(String) -> String) -> Result<Scenario, ScenarioError> {
+    fn two_rooms(mut edit: impl FnMut(String) -> String) -> Result<Scenario, ScenarioError> {
         let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenarios/paper_two_rooms.toml");
         let text = std::fs::read_to_string(&path).unwrap();
         Scenario::parse(&edit(text), &path)
@@ -661,5 +634,54 @@ mod tests {
         assert_eq!(s.description.as_deref(), Some("two heterogeneous robots map two rooms and merge by the door"));
         let s = two_rooms(|t| t.lines().filter(|l| !l.starts_with("description")).collect::<Vec<_>>().join("\n"));
         assert_eq!(s.unwrap().description, None);
+    }
+
+    /// The 1-based line of the last line of `text` holding `needle` (for the tests' expectations only).
+    fn line_holding(text: &str, needle: &str) -> usize {
+        text.lines().enumerate().filter(|(_, l)| l.contains(needle)).last().unwrap().0 + 1
+    }
+
+    /// `paper_two_rooms.toml` with `from` replaced by `to` in the second robot's table: the error, and the
+    /// line `to` is on.
+    fn second_robot(from: &str, to: &str) -> (ScenarioError, usize) {
+        let mut text = String::new();
+        let e = two_rooms(|t| {
+            let (head, second) = t.split_at(t.rfind("[[robots]]").unwrap());
+            text = format!("{head}{}", second.replacen(from, to, 1));
+            text.clone()
+        })
+        .unwrap_err();
+        let line = line_holding(&text, to);
+        (e, line)
+    }
+
+    #[test]
+    fn errors_name_the_line_of_the_offending_value() {
+        // The second robot's speed, not the first's `speed =` line.
+        let (e, line) = second_robot("speed = 0.3", "speed = -0.4");
+        assert_eq!((e.field.as_str(), e.line), ("robots[1].speed", line), "{e}");
+        assert!(line > 30, "{line}");
+        // A waypoint outside the world: its robot's route line, not a comment that says "route".
+        let (e, line) = second_robot("[9.4, 2.0]", "[94.0, 2.0]");
+        assert_eq!((e.field.as_str(), e.line), ("robots[1].route[2]", line), "{e}");
+        // A duplicate name: the second `name =` line, not the merge host's.
+        let (e, line) = second_robot("name = \"prawn\"", "name = \"experia\"");
+        assert_eq!((e.field.as_str(), e.line), ("robots[1].name", line), "{e}");
+        assert!(e.message.contains("both robots are named `experia`"), "{e}");
+        // A file that cannot be read names no line 0.
+        let e = Scenario::from_file(Path::new("/nonexistent/s.toml")).unwrap_err();
+        assert!(e.to_string().starts_with("/nonexistent/s.toml: file: "), "{e}");
+    }
+
+    #[test]
+    fn starts_outside_the_world_or_on_the_other_robot_are_refused() {
+        let (e, line) = second_robot("start = \"start_prawn\"", "start = [-20.0, 2.5, 0.0]");
+        assert_eq!((e.field.as_str(), e.line), ("robots[1].start", line), "{e}");
+        assert!(e.message.contains("(-20.00, 2.50), outside the world"), "{e}");
+        let (e, line) = second_robot("start = \"start_prawn\"", "start = \"start_experia\"");
+        assert_eq!((e.field.as_str(), e.line), ("robots[1].start", line), "{e}");
+        assert!(e.message.contains("robot `prawn` would start 0.00 m from robot `experia`"), "{e}");
+        let shown = e.to_string();
+        assert!(shown.contains(&format!("paper_two_rooms.toml:{line}: robots[1].start: ")), "{shown}");
     }
 }

@@ -14,6 +14,7 @@
 //! trial index) alone ([`trial`]), so a shard computes exactly the rows the whole study would.
 
 pub mod algorithms;
+pub mod journal;
 pub mod overlap;
 pub mod plot;
 pub mod range;
@@ -41,7 +42,7 @@ pub enum StudyError {
         message: String,
     },
     /// A results file is malformed, or shards disagree.
-    #[error("{path}:{line}: {message}")]
+    #[error("{}: {message}", crate::scenario::at(path, *line))]
     Results {
         /// File at fault.
         path: PathBuf,
@@ -66,7 +67,24 @@ impl StudyError {
     }
 }
 
+/// What a study does as it goes: it asks whether to run each selected trial (a resumed study skips those it
+/// has), and hands over each finished trial's rows at once (the CLI appends them to `results.csv`).
+pub trait Progress: Sync {
+    /// Whether trial `trial` is already done and is to be skipped.
+    fn skip(&self, _trial: usize) -> bool {
+        false
+    }
+    /// Called with the rows of each finished trial, from the worker thread that ran it.
+    fn finished(&self, _rows: &[TrialRow]) -> Result<(), StudyError> {
+        Ok(())
+    }
+}
+
+/// No resume, nothing reported.
+impl Progress for () {}
+
 pub use algorithms::{check_algorithms, parse_algorithms, study_merger};
+pub use journal::{Journal, StudyParams};
 pub use overlap::{MapSource, OverlapStudy, run_overlap_study};
 pub use range::parse_range;
 pub use results::{TrialRow, collect, read_results, write_results};

@@ -1,11 +1,11 @@
 //! Map-level studies: cut ground-truth maps into pairs of chosen overlap, merge each pair with every
 //! algorithm through the verification gate, score against the pair's true transform.
 
-use super::StudyError;
 use super::algorithms::{check_algorithms, study_merger};
 use super::results::{TrialRow, sort_rows};
 use super::shard::Shard;
 use super::trial::{TrialSpec, mix, trials};
+use super::{Progress, StudyError};
 use crate::eval::transform_error;
 use mrslam_core::OccupancyGrid;
 use mrslam_merge::floorplan::{FloorplanParams, generate};
@@ -90,9 +90,9 @@ pub fn floorplan_seed(seed: u64, k: usize) -> u64 {
 
 /// Runs the study's trials of this shard in parallel, calling `progress` after each; rows sorted by trial,
 /// then algorithm in the study's order.
-pub fn run_overlap_study(study: &OverlapStudy, progress: &(dyn Fn() + Sync)) -> Result<Vec<TrialRow>, StudyError> {
+pub fn run_overlap_study(study: &OverlapStudy, progress: &dyn Progress) -> Result<Vec<TrialRow>, StudyError> {
     study.validate()?;
-    let selected = study.selected_trials();
+    let selected: Vec<TrialSpec> = study.selected_trials().into_iter().filter(|t| !progress.skip(t.trial)).collect();
     let plans: Vec<Option<OccupancyGrid>> = match &study.source {
         MapSource::Floorplans { count, params } => {
             // Only the plans this shard uses.
@@ -107,16 +107,16 @@ pub fn run_overlap_study(study: &OverlapStudy, progress: &(dyn Fn() + Sync)) -> 
         }
         MapSource::Map(g) => vec![Some(g.clone())],
     };
-    let mut rows: Vec<TrialRow> = selected
+    let rows: Vec<Vec<TrialRow>> = selected
         .par_iter()
         .map(|t| {
             // Every plan a selected trial uses was built above.
             let r = plans[t.rep % plans.len()].as_ref().map(|map| run_trial(study, map, t)).unwrap_or_default();
-            progress();
-            r
+            progress.finished(&r)?;
+            Ok(r)
         })
-        .flatten()
-        .collect();
+        .collect::<Result<_, StudyError>>()?;
+    let mut rows: Vec<TrialRow> = rows.into_iter().flatten().collect();
     sort_rows(&mut rows, &study.algorithms);
     Ok(rows)
 }
@@ -178,12 +178,12 @@ mod tests {
 
     #[test]
     fn shards_compute_the_rows_of_the_whole() {
-        let whole = run_overlap_study(&small(), &|| {}).unwrap();
+        let whole = run_overlap_study(&small(), &()).unwrap();
         assert_eq!(whole.len(), 4);
         let mut parts = Vec::new();
         for k in 0..2 {
             let s = OverlapStudy { shard: Shard::new(k, 2).unwrap(), ..small() };
-            parts.extend(run_overlap_study(&s, &|| {}).unwrap());
+            parts.extend(run_overlap_study(&s, &()).unwrap());
         }
         sort_rows(&mut parts, &[Algorithm::Sift]);
         let strip = |r: &TrialRow| TrialRow { time_ms: 0.0, ..r.clone() };
@@ -196,11 +196,11 @@ mod tests {
 
     #[test]
     fn bad_parameters_are_refused() {
-        assert!(run_overlap_study(&OverlapStudy { trials: 0, ..small() }, &|| {}).is_err());
-        let e = run_overlap_study(&OverlapStudy { algorithms: vec![], ..small() }, &|| {});
+        assert!(run_overlap_study(&OverlapStudy { trials: 0, ..small() }, &()).is_err());
+        let e = run_overlap_study(&OverlapStudy { algorithms: vec![], ..small() }, &());
         assert!(e.unwrap_err().to_string().contains("no algorithms"));
         let twice = vec![Algorithm::Rmap, Algorithm::Rmap];
-        let e = run_overlap_study(&OverlapStudy { algorithms: twice, ..small() }, &|| {});
+        let e = run_overlap_study(&OverlapStudy { algorithms: twice, ..small() }, &());
         assert!(e.unwrap_err().to_string().contains("given twice"));
     }
 }

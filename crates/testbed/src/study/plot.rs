@@ -147,7 +147,10 @@ pub fn draw(summary: &[SummaryRow], path: &Path) -> Result<(), StudyError> {
     let buf = render(summary).map_err(|e| StudyError::file(path, format!("drawing the plot: {e}")))?;
     let img = image::RgbImage::from_raw(WIDTH, HEIGHT, buf)
         .ok_or_else(|| StudyError::file(path, "plot buffer of the wrong size"))?;
-    img.save_with_format(path, image::ImageFormat::Png).map_err(|e| StudyError::file(path, e))
+    let mut bytes = Vec::new();
+    img.write_to(&mut std::io::Cursor::new(&mut bytes), image::ImageFormat::Png)
+        .map_err(|e| StudyError::file(path, e))?;
+    mrslam_core::map_io::write_file_atomic(path, &bytes).map_err(|e| StudyError::file(path, e))
 }
 
 #[cfg(test)]

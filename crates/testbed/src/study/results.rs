@@ -130,12 +130,27 @@ pub fn write_results(rows: &[TrialRow], path: &Path) -> Result<(), StudyError> {
     for r in rows {
         let _ = writeln!(s, "{}", r.to_csv());
     }
-    std::fs::write(path, s).map_err(|e| StudyError::file(path, e))
+    mrslam_core::map_io::write_file_atomic(path, s.as_bytes()).map_err(|e| StudyError::file(path, e))
 }
 
 /// Reads a `results.csv`, checking its header.
 pub fn read_results(path: &Path) -> Result<Vec<TrialRow>, StudyError> {
-    let text = std::fs::read_to_string(path).map_err(|e| StudyError::file(path, e))?;
+    Ok(read_numbered(path)?.into_iter().map(|(_, r)| r).collect())
+}
+
+/// Reads a `results.csv` with each row's 1-based line.
+fn read_numbered(path: &Path) -> Result<Vec<(usize, TrialRow)>, StudyError> {
+    let text = mrslam_core::input::read_text_limited(path, mrslam_core::input::DATA_LIMIT)
+        .map_err(|e| StudyError::file(path, e))?;
+    parse_numbered(&text, path)
+}
+
+/// Parses the text of a `results.csv`, checking its header; `path` only names it in errors.
+pub fn parse_results(text: &str, path: &Path) -> Result<Vec<TrialRow>, StudyError> {
+    Ok(parse_numbered(text, path)?.into_iter().map(|(_, r)| r).collect())
+}
+
+fn parse_numbered(text: &str, path: &Path) -> Result<Vec<(usize, TrialRow)>, StudyError> {
     let err = |line: usize, message: String| StudyError::Results { path: path.to_path_buf(), line, message };
     let mut lines = text.lines().enumerate();
     match lines.next() {
@@ -143,7 +158,10 @@ pub fn read_results(path: &Path) -> Result<Vec<TrialRow>, StudyError> {
         Some((_, h)) => return Err(err(1, format!("header `{}` is not the expected `{HEADER}`", h.trim()))),
         None => return Err(err(1, "empty file, expected a header".into())),
     }
-    lines.filter(|(_, l)| !l.trim().is_empty()).map(|(i, l)| TrialRow::from_csv(l).map_err(|m| err(i + 1, m))).collect()
+    lines
+        .filter(|(_, l)| !l.trim().is_empty())
+        .map(|(i, l)| TrialRow::from_csv(l).map(|r| (i + 1, r)).map_err(|m| err(i + 1, m)))
+        .collect()
 }
 
 /// Joins the `results.csv` of several shard folders, refusing a (trial, algorithm) found twice.
@@ -152,18 +170,18 @@ pub fn collect(dirs: &[PathBuf]) -> Result<Vec<TrialRow>, StudyError> {
     if dirs.is_empty() {
         return Err(StudyError::Invalid("collect: no shard folders given".into()));
     }
-    let mut seen: BTreeMap<(usize, String), PathBuf> = BTreeMap::new();
+    let mut seen: BTreeMap<(usize, String), (PathBuf, usize)> = BTreeMap::new();
     let mut order: Vec<String> = Vec::new();
     let mut all = Vec::new();
     for d in dirs {
         let path = d.join("results.csv");
-        for r in read_results(&path)? {
-            if let Some(first) = seen.insert((r.trial, r.algorithm.clone()), path.clone()) {
+        for (line, r) in read_numbered(&path)? {
+            if let Some((first, first_line)) = seen.insert((r.trial, r.algorithm.clone()), (path.clone(), line)) {
                 return Err(StudyError::Results {
                     path,
-                    line: 0,
+                    line,
                     message: format!(
-                        "trial {} of `{}` is also in {}: shards overlap (same shard collected twice?)",
+                        "trial {} of `{}` is also in {}:{first_line}: shards overlap (same shard collected twice?)",
                         r.trial,
                         r.algorithm,
                         first.display()

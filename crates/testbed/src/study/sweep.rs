@@ -14,13 +14,14 @@
 //! Trials: variant-major, `trial = variant * seeds.len() + seed index`. A trial's overlap is the run's
 //! observed overlap (Jaccard of the true cells each robot's beams crossed), not an assumed one.
 
-use super::StudyError;
 use super::algorithms::parse_algorithms;
 use super::results::{TrialRow, sort_rows};
 use super::shard::Shard;
+use super::{Progress, StudyError};
 use crate::runner::{RunOptions, run};
 use crate::scenario::Scenario;
 use mrslam_core::pose;
+use mrslam_core::toml_lines::TomlLines;
 use mrslam_merge::Algorithm;
 use mrslam_sim::World;
 use rayon::prelude::*;
@@ -85,29 +86,33 @@ pub struct Sweep {
     pub vary: Vec<Vary>,
 }
 
-fn line_of(text: &str, needle: &str) -> usize {
-    text.lines().position(|l| l.contains(needle)).map_or(0, |i| i + 1)
-}
-
 impl Sweep {
     /// Reads and checks a sweep file (and the scenario it names); errors name the file, line and field.
     pub fn from_file(path: &Path) -> Result<Sweep, StudyError> {
-        let text = std::fs::read_to_string(path).map_err(|e| StudyError::file(path, e))?;
+        let text = mrslam_core::input::read_text_limited(path, mrslam_core::input::CONFIG_LIMIT)
+            .map_err(|e| StudyError::file(path, e))?;
+        Self::parse(&text, path)
+    }
+
+    /// Checks a sweep from its text; `path` names it in errors and anchors the scenario's path.
+    pub fn parse(text: &str, path: &Path) -> Result<Sweep, StudyError> {
         let at = |line: usize, message: String| StudyError::Results { path: path.to_path_buf(), line, message };
-        let file: SweepFile = toml::from_str(&text).map_err(|e| {
-            let line = e.span().map_or(0, |s| text[..s.start.min(text.len())].matches('\n').count() + 1);
+        let file: SweepFile = toml::from_str(text).map_err(|e| {
+            let line = e.span().map_or(0, |s| mrslam_core::toml_lines::line_at(text, s.start));
             at(line, e.message().to_string())
         })?;
+        let lines = TomlLines::new(text);
+        let line_of = |field: &str| lines.line(field);
         let dir = path.parent().unwrap_or(Path::new("."));
         let scenario = Scenario::from_file(&dir.join(&file.scenario))
-            .map_err(|e| at(line_of(&text, "scenario"), format!("scenario: {e}")))?;
+            .map_err(|e| at(line_of("scenario"), format!("scenario: {e}")))?;
         let algorithms = match &file.algorithms {
             Some(names) => parse_algorithms(names),
             None => super::check_algorithms(&scenario.merge.algorithms).map(|()| scenario.merge.algorithms.clone()),
         }
-        .map_err(|e| at(line_of(&text, "algorithms"), format!("algorithms: {e}")))?;
+        .map_err(|e| at(line_of("algorithms"), format!("algorithms: {e}")))?;
         if file.seeds.is_empty() {
-            return Err(at(line_of(&text, "seeds"), "seeds: give at least one seed".into()));
+            return Err(at(line_of("seeds"), "seeds: give at least one seed".into()));
         }
         let mut vary = Vec::new();
         for (i, v) in file.vary.iter().enumerate() {
@@ -115,7 +120,7 @@ impl Sweep {
             let robot = scenario.robots.iter().position(|r| r.name == v.robot).ok_or_else(|| {
                 let names: Vec<&str> = scenario.robots.iter().map(|r| r.name.as_str()).collect();
                 at(
-                    line_of(&text, &format!("\"{}\"", v.robot)),
+                    line_of(&f("robot")),
                     format!("{}: no robot `{}` in the scenario (robots: {})", f("robot"), v.robot, names.join(", ")),
                 )
             })?;
@@ -125,19 +130,19 @@ impl Sweep {
                 "speed" => Field::Speed,
                 other => {
                     return Err(at(
-                        line_of(&text, &format!("\"{other}\"")),
+                        line_of(&f("field")),
                         format!("{}: unknown field `{other}` (expected one of {})", f("field"), FIELDS.join(", ")),
                     ));
                 }
             };
             if v.values.is_empty() {
-                return Err(at(line_of(&text, "values"), format!("{}: give at least one value", f("values"))));
+                return Err(at(line_of(&f("values")), format!("{}: give at least one value", f("values"))));
             }
             if let Some(first) = file.vary.first()
                 && first.values.len() != v.values.len()
             {
                 return Err(at(
-                    0,
+                    line_of(&f("values")),
                     format!(
                         "{}: {} values, but vary[0] has {}: all [[vary]] lists step together and need equal lengths",
                         f("values"),
@@ -150,7 +155,7 @@ impl Sweep {
         }
         let sweep = Sweep { path: path.to_path_buf(), scenario, algorithms, seeds: file.seeds, vary };
         // Every variant must be drivable: check each waypoint and speed now, not an hour into the study.
-        let world = World::from_spec(&sweep.scenario.world).map_err(|e| at(0, e.to_string()))?;
+        let world = World::from_spec(&sweep.scenario.world).map_err(|e| at(line_of("scenario"), e.to_string()))?;
         for k in 0..sweep.variants() {
             let s = sweep.variant(k, sweep.seeds[0]);
             for (i, v) in sweep.vary.iter().enumerate() {
@@ -171,7 +176,8 @@ impl Sweep {
                     }),
                 };
                 if let Some(p) = problem {
-                    return Err(at(line_of(&text, "values"), format!("vary[{i}].values[{k}] = {value}: {p}")));
+                    let field = format!("vary[{i}].values[{k}]");
+                    return Err(at(line_of(&field), format!("{field} = {value}: {p}")));
                 }
             }
         }
@@ -225,16 +231,16 @@ impl Sweep {
 }
 
 /// Runs the sweep's trials of this shard in parallel, calling `progress` after each.
-pub fn run_sweep(sweep: &Sweep, shard: Shard, progress: &(dyn Fn() + Sync)) -> Result<Vec<TrialRow>, StudyError> {
+pub fn run_sweep(sweep: &Sweep, shard: Shard, progress: &dyn Progress) -> Result<Vec<TrialRow>, StudyError> {
     let n_seeds = sweep.seeds.len();
-    let selected: Vec<usize> = (0..sweep.trials()).filter(|t| shard.selects(*t)).collect();
+    let selected: Vec<usize> = (0..sweep.trials()).filter(|t| shard.selects(*t) && !progress.skip(*t)).collect();
     let rows: Vec<Vec<TrialRow>> = selected
         .par_iter()
         .map(|&trial| {
             let scenario = sweep.variant(trial / n_seeds, sweep.seeds[trial % n_seeds]);
-            let r = run_trial(sweep, &scenario, trial);
-            progress();
-            r
+            let r = run_trial(sweep, &scenario, trial)?;
+            progress.finished(&r)?;
+            Ok(r)
         })
         .collect::<Result<_, _>>()?;
     let mut rows: Vec<TrialRow> = rows.into_iter().flatten().collect();
@@ -266,4 +272,33 @@ fn run_trial(sweep: &Sweep, scenario: &Scenario, trial: usize) -> Result<Vec<Tri
             translation_error_at_end_m: m.translation_error_at_end_m,
         })
         .collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Writes `text` as a sweep beside the shipped scenarios and reads it.
+    fn sweep_error(text: &str) -> String {
+        let dir = tempfile::tempdir().unwrap();
+        let scenarios = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenarios");
+        let text = text.replace("SCENARIO", &scenarios.join("paper_corridor.toml").display().to_string());
+        let path = dir.path().join("sweep.toml");
+        std::fs::write(&path, text).unwrap();
+        Sweep::from_file(&path).unwrap_err().to_string()
+    }
+
+    #[test]
+    fn sweep_errors_name_the_line_of_the_value() {
+        let head = "# robots, values and routes are described below\nscenario = \"SCENARIO\"\nseeds = [1]\n";
+        let vary = |robot: &str, values: &str| {
+            format!("[[vary]]\nrobot = \"{robot}\"\nfield = \"speed\"\nvalues = {values}\n")
+        };
+        let e = sweep_error(&format!("{head}{}{}", vary("experia", "[0.3, 0.4]"), vary("prawn", "[0.3]")));
+        assert!(e.contains("sweep.toml:11: vary[1].values: 1 values, but vary[0] has 2"), "{e}");
+        let e = sweep_error(&format!("{head}{}{}", vary("experia", "[0.3, 0.4]"), vary("prawn", "[0.3, 9.0]")));
+        assert!(e.contains("sweep.toml:11: vary[1].values[1] = 9: speed 9 outside"), "{e}");
+        let e = sweep_error(&format!("{head}{}{}", vary("experia", "[0.3]"), vary("robbie", "[0.3]")));
+        assert!(e.contains("sweep.toml:9: vary[1].robot: no robot `robbie`"), "{e}");
+    }
 }

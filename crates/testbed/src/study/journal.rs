@@ -1,0 +1,260 @@
+//! A study's folder while the study runs: `study.json` says what the study is, and `results.csv` gets each
+//! finished trial's rows appended and flushed at once, so an interrupted study loses no finished trial and
+//! `--resume` continues it. `collect` compares the shards' `study.json` and refuses shards of other studies.
+
+use super::StudyError;
+use super::results::{HEADER, TrialRow};
+use std::collections::{BTreeMap, BTreeSet};
+use std::io::Write as _;
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+
+/// Name of the parameters file in a study folder.
+pub const PARAMS_FILE: &str = "study.json";
+
+/// Name of the results file in a study folder.
+pub const RESULTS_FILE: &str = "results.csv";
+
+/// What a study is, by parameter name (the shard aside): two folders hold results of one study exactly when
+/// their parameters are equal.
+#[derive(Debug, Clone, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct StudyParams(pub BTreeMap<String, String>);
+
+/// A 64-bit FNV-1a fingerprint of some bytes (a map, a sweep file), stable across machines and versions.
+pub fn fingerprint(bytes: &[u8]) -> String {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for &b in bytes {
+        h ^= b as u64;
+        h = h.wrapping_mul(0x0000_0100_0000_01b3);
+    }
+    format!("{h:016x}")
+}
+
+impl StudyParams {
+    /// Sets parameter `name`.
+    pub fn set(&mut self, name: &str, value: impl ToString) -> &mut Self {
+        self.0.insert(name.to_string(), value.to_string());
+        self
+    }
+
+    /// Reads `dir/study.json`; `None` when the folder has none.
+    pub fn read(dir: &Path) -> Result<Option<StudyParams>, StudyError> {
+        let path = dir.join(PARAMS_FILE);
+        let text = match std::fs::read_to_string(&path) {
+            Ok(t) => t,
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+            Err(e) => return Err(StudyError::file(&path, e)),
+        };
+        serde_json::from_str(&text).map(Some).map_err(|e| StudyError::Results {
+            path,
+            line: e.line(),
+            message: format!("not a study's parameters: {e}"),
+        })
+    }
+
+    /// Writes `dir/study.json` (through a temporary file).
+    pub fn write(&self, dir: &Path) -> Result<(), StudyError> {
+        let path = dir.join(PARAMS_FILE);
+        let text = serde_json::to_string_pretty(self).map_err(|e| StudyError::file(&path, e))? + "\n";
+        mrslam_core::map_io::write_file_atomic(&path, text.as_bytes()).map_err(|e| StudyError::file(&path, e))
+    }
+
+    /// Fails, naming the first parameter that differs, unless `other` (read from `path`) is the same study.
+    pub fn check_same(&self, other: &StudyParams, path: &Path, what: &str) -> Result<(), StudyError> {
+        let keys: BTreeSet<&String> = self.0.keys().chain(other.0.keys()).collect();
+        for k in keys {
+            let (mine, theirs) = (self.0.get(k), other.0.get(k));
+            if mine != theirs {
+                let show = |v: Option<&String>| v.map_or("(none)".to_string(), |v| format!("`{v}`"));
+                return Err(StudyError::Results {
+                    path: path.to_path_buf(),
+                    line: 0,
+                    message: format!(
+                        "{what}: `{k}` is {} there but {} here: results of different studies do not mix",
+                        show(theirs),
+                        show(mine)
+                    ),
+                });
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The parameters of the study whose shards `dirs` hold: refuses shards of different studies, and a mix of
+/// shards with and without `study.json`; `None` when no shard has one (folders of an older mrslam).
+pub fn collect_params(dirs: &[PathBuf]) -> Result<Option<StudyParams>, StudyError> {
+    let mut first: Option<(&PathBuf, Option<StudyParams>)> = None;
+    for d in dirs {
+        let p = StudyParams::read(d)?;
+        match &first {
+            None => first = Some((d, p)),
+            Some((d0, p0)) => match (p0, &p) {
+                (Some(a), Some(b)) => {
+                    a.check_same(b, &d.join(PARAMS_FILE), &format!("not a shard of the study in {}", d0.display()))?
+                }
+                (None, None) => {}
+                _ => {
+                    let (with, without) = if p0.is_some() { (*d0, d) } else { (d, *d0) };
+                    return Err(StudyError::File {
+                        path: without.join(PARAMS_FILE),
+                        message: format!(
+                            "missing, while {} has one: cannot tell whether they are one study",
+                            with.display()
+                        ),
+                    });
+                }
+            },
+        }
+    }
+    Ok(first.and_then(|(_, p)| p))
+}
+
+/// The `results.csv` of a running study, appended to trial by trial.
+pub struct Journal {
+    path: PathBuf,
+    file: Mutex<std::fs::File>,
+}
+
+impl Journal {
+    /// Opens `dir` for the study `params` whose trials write `rows_per_trial` rows each.
+    ///
+    /// Fresh (`resume` false): refuses a folder that already holds a `results.csv`, so no result is lost to
+    /// a rerun. Resumed: the folder's `study.json` must match; the complete trials of its `results.csv` come
+    /// back (a trial cut off by the interruption is dropped and runs again).
+    pub fn open(
+        dir: &Path,
+        params: &StudyParams,
+        rows_per_trial: usize,
+        resume: bool,
+    ) -> Result<(Journal, Vec<TrialRow>), StudyError> {
+        std::fs::create_dir_all(dir).map_err(|e| StudyError::file(dir, e))?;
+        let path = dir.join(RESULTS_FILE);
+        let done = if resume {
+            let found = StudyParams::read(dir)?.ok_or_else(|| StudyError::File {
+                path: dir.join(PARAMS_FILE),
+                message: "nothing to resume: no study was started in this folder".into(),
+            })?;
+            params.check_same(&found, &dir.join(PARAMS_FILE), "cannot resume")?;
+            let text = match std::fs::read_to_string(&path) {
+                Ok(t) => t,
+                Err(e) if e.kind() == std::io::ErrorKind::NotFound => String::new(),
+                Err(e) => return Err(StudyError::file(&path, e)),
+            };
+            complete_trials(&text, &path, rows_per_trial)?
+        } else {
+            if path.exists() {
+                return Err(StudyError::File {
+                    path,
+                    message: "already holds the results of a study: --resume continues it, or choose another --out"
+                        .into(),
+                });
+            }
+            params.write(dir)?;
+            Vec::new()
+        };
+        // Start the file anew with the header and the complete trials, then append.
+        let mut text = format!("{HEADER}\n");
+        for r in &done {
+            text += &r.to_csv();
+            text.push('\n');
+        }
+        mrslam_core::map_io::write_file_atomic(&path, text.as_bytes()).map_err(|e| StudyError::file(&path, e))?;
+        let file = std::fs::OpenOptions::new().append(true).open(&path).map_err(|e| StudyError::file(&path, e))?;
+        Ok((Journal { path, file: Mutex::new(file) }, done))
+    }
+
+    /// Appends one trial's rows in one write and flushes them to the file.
+    pub fn append(&self, rows: &[TrialRow]) -> Result<(), StudyError> {
+        let mut text = String::new();
+        for r in rows {
+            text += &r.to_csv();
+            text.push('\n');
+        }
+        let mut file = self.file.lock().map_err(|_| StudyError::file(&self.path, "a writer panicked"))?;
+        file.write_all(text.as_bytes()).and_then(|()| file.flush()).map_err(|e| StudyError::file(&self.path, e))
+    }
+}
+
+/// The rows of the trials `text` holds completely: lines cut off, and trials with fewer than
+/// `rows_per_trial` rows, are dropped.
+fn complete_trials(text: &str, path: &Path, rows_per_trial: usize) -> Result<Vec<TrialRow>, StudyError> {
+    // Only lines that end in a newline were written completely.
+    let whole = &text[..text.rfind('\n').map_or(0, |i| i + 1)];
+    let mut lines = whole.lines().enumerate();
+    match lines.next() {
+        None => return Ok(Vec::new()),
+        Some((_, h)) if h.trim() == HEADER => {}
+        Some((_, h)) => {
+            return Err(StudyError::Results {
+                path: path.to_path_buf(),
+                line: 1,
+                message: format!("header `{}` is not the expected `{HEADER}`", h.trim()),
+            });
+        }
+    }
+    let mut rows = Vec::new();
+    for (i, l) in lines.filter(|(_, l)| !l.trim().is_empty()) {
+        let r = TrialRow::from_csv(l).map_err(|message| StudyError::Results {
+            path: path.to_path_buf(),
+            line: i + 1,
+            message,
+        })?;
+        rows.push(r);
+    }
+    let mut count: BTreeMap<usize, usize> = BTreeMap::new();
+    for r in &rows {
+        *count.entry(r.trial).or_default() += 1;
+    }
+    rows.retain(|r| count[&r.trial] == rows_per_trial);
+    Ok(rows)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn row(trial: usize, alg: &str) -> TrialRow {
+        TrialRow {
+            trial,
+            overlap_target: Some(0.2),
+            overlap: 0.2,
+            seed: 1,
+            algorithm: alg.into(),
+            accepted: true,
+            success: true,
+            false_merge: false,
+            rotation_error_deg: Some(0.1),
+            translation_error_m: Some(0.01),
+            time_ms: 1.0,
+            rotation_error_at_end_deg: None,
+            translation_error_at_end_m: None,
+        }
+    }
+
+    #[test]
+    fn an_interrupted_study_resumes_with_its_complete_trials() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut params = StudyParams::default();
+        params.set("seed", 5);
+        let (j, done) = Journal::open(dir.path(), &params, 2, false).unwrap();
+        assert!(done.is_empty());
+        j.append(&[row(0, "sift"), row(0, "rmap")]).unwrap();
+        j.append(&[row(3, "sift")]).unwrap(); // a trial cut off after its first row
+        drop(j);
+        // A line cut off in the middle.
+        let path = dir.path().join(RESULTS_FILE);
+        let mut f = std::fs::OpenOptions::new().append(true).open(&path).unwrap();
+        f.write_all(b"4,0.2,0.2").unwrap();
+        drop(f);
+        // A fresh start in the folder is refused; a resume of another study too.
+        assert!(Journal::open(dir.path(), &params, 2, false).is_err());
+        let mut other = params.clone();
+        other.set("seed", 6);
+        let e = Journal::open(dir.path(), &other, 2, true).err().unwrap().to_string();
+        assert!(e.contains("`seed` is `5` there but `6` here"), "{e}");
+        let (_, done) = Journal::open(dir.path(), &params, 2, true).unwrap();
+        assert_eq!(done, vec![row(0, "sift"), row(0, "rmap")]);
+        assert_eq!(std::fs::read_to_string(&path).unwrap().lines().count(), 3, "the file holds what was kept");
+    }
+}

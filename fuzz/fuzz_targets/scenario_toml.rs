@@ -1,0 +1,10 @@
+//! A scenario file's text, beside the shipped scenarios (so `world = "../worlds/..."` resolves).
+#![no_main]
+use libfuzzer_sys::fuzz_target;
+
+fuzz_target!(|data: &[u8]| {
+    if let Ok(text) = std::str::from_utf8(data) {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/fuzz.toml");
+        let _ = mrslam_testbed::scenario::Scenario::parse(text, &path);
+    }
+});
