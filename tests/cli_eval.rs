@@ -119,9 +119,22 @@ fn unmatched_stamps_and_bad_files_are_refused() {
         &["eval", "relations", traj.to_str().unwrap(), short.to_str().unwrap()],
         "short.relations:1: expected 8 fields",
     );
+    // (relations in a file named .json, so that the output's extension is not what refuses it)
+    let rel_json = write(dir.path(), "c.json", &relations());
+    fails(
+        &[
+            "eval",
+            "relations",
+            traj.to_str().unwrap(),
+            rel_json.to_str().unwrap(),
+            "--json",
+            rel_json.to_str().unwrap(),
+        ],
+        "refusing to write an output over the input",
+    );
     fails(
         &["eval", "relations", traj.to_str().unwrap(), rel.to_str().unwrap(), "--json", rel.to_str().unwrap()],
-        "refusing to write an output over the input",
+        "expected .json",
     );
     assert_eq!(std::fs::read_to_string(&rel).unwrap(), relations(), "the input was touched");
 }
