@@ -131,19 +131,23 @@ fn outputs_that_cannot_be_written_fail_before_the_merge() {
     write_ros_map(&generate(24, &FloorplanParams::default()), &d.join("a.yaml")).unwrap();
     let map = d.join("a.yaml");
     let a = p(&map);
-    let missing = d.join("no/such/folder/m.yaml");
-    for args in [
-        vec!["merge", a, a, "-o", p(&missing)],
-        vec!["merge", a, a, "--report", p(&missing)],
-        vec!["merge", a, a, "--matches-png", p(&missing)],
+    let missing = |name: &str| d.join("no/such/folder").join(name);
+    let (yaml, json, png) = (missing("m.yaml"), missing("r.json"), missing("m.png"));
+    for (args, out) in [
+        (vec!["merge", a, a, "-o", p(&yaml)], &yaml),
+        (vec!["merge", a, a, "--report", p(&json)], &json),
+        (vec!["merge", a, a, "--matches-png", p(&png)], &png),
     ] {
         let o = mrslam(&args);
         let e = text(&o.stderr);
         assert_eq!(o.status.code(), Some(1), "{args:?}: {e}");
-        assert!(e.contains(p(&missing)) && e.contains("does not exist"), "{e}");
+        assert!(e.contains(p(out)) && e.contains("does not exist"), "{e}");
         assert!(!text(&o.stdout).contains("ACCEPTED"), "the merge ran before the output was checked");
     }
-    let o = mrslam(&["merge", a, a, "-o", p(d)]);
+    // a folder named like a map
+    let folder = d.join("folder.yaml");
+    std::fs::create_dir(&folder).unwrap();
+    let o = mrslam(&["merge", a, a, "-o", p(&folder)]);
     assert_eq!(o.status.code(), Some(1));
     assert!(text(&o.stderr).contains("it is a folder"), "{}", text(&o.stderr));
 }
