@@ -72,7 +72,7 @@ fn update(c: &mut Criterion) {
 
 /// The office loop seen by a SICK-class lidar of `beams` beams over 180° (80 m), 0.05 m per scan.
 fn sick_office(beams: usize) -> synthetic::SyntheticRun {
-    let lidar = Lidar { fov: std::f64::consts::PI, beams, range_max: 80.0, ..Lidar::hokuyo() };
+    let lidar = Lidar { beams, range_max: 80.0, ..Lidar::sick() };
     let path = synthetic::waypoint_path(&synthetic::office_loop(), 0.05, 0.1);
     synthetic::simulate(&synthetic::office_map(), &path, 0.1, &lidar, pose(0.0, 0.0, 0.0), &drift(), 1)
 }

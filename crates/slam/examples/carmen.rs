@@ -36,7 +36,7 @@ fn main() {
         if f.process(&rec.odometry, &rec.scan).expect("a reading").is_processed() {
             processed.push(i);
         }
-        odometry.push(f.odometry_pose().expect("a pose"));
+        odometry.push(f.odometry_pose().unwrap_or(rec.odometry.pose));
         if let Ok(r) = std::env::var("DEBUG_RANGE") {
             let (a, b) = r.split_once(',').expect("a,b");
             let st = rec.scan.stamp;
@@ -59,16 +59,7 @@ fn main() {
         let traj: Vec<StampedPose> =
             stamps.iter().zip(&odometry).map(|(&stamp, &pose)| StampedPose { stamp, pose }).collect();
         let s = relations::score(&traj, &rels, 0.001);
-        println!(
-            "odometry alone: {:.4} ± {:.4} m (max {:.3}), {:.3} ± {:.3} deg (max {:.2}), scan odometry {:?}",
-            s.translation.mean,
-            s.translation.std,
-            s.translation.max,
-            s.rotation.mean.to_degrees(),
-            s.rotation.std.to_degrees(),
-            s.rotation.max.to_degrees(),
-            f.scan_odometry_counts()
-        );
+        println!("odometry alone: {}, scan odometry {:?}", errors(&s), f.scan_odometry_counts());
     }
     let anchors: Vec<(usize, Pose2)> = processed.iter().copied().zip(f.trajectory().into_iter().map(|k| k.1)).collect();
     let poses = poses_at_every_scan(&stamps, &odometry, &anchors).expect("processed scans");
@@ -107,13 +98,8 @@ fn main() {
     }
     let duration = stamps[stamps.len() - 1] - stamps[0];
     println!(
-        "seed {seed}: {:.4} ± {:.4} m (max {:.3}), {:.3} ± {:.3} deg (max {:.2}), used {} missing {}, {} processed, {} resamples, {:.1} s = {:.1}x real time",
-        s.translation.mean,
-        s.translation.std,
-        s.translation.max,
-        s.rotation.mean.to_degrees(),
-        s.rotation.std.to_degrees(),
-        s.rotation.max.to_degrees(),
+        "seed {seed}: {}, used {} missing {}, {} processed, {} resamples, {:.1} s = {:.1}x real time",
+        errors(&s),
         s.used(),
         s.missing.len(),
         c.processed,
@@ -124,4 +110,17 @@ fn main() {
     if let Some(out) = map_out {
         mrslam_core::map_io::write_ros_map(&f.map().expect("a map"), std::path::Path::new(&out)).expect("written");
     }
+}
+
+/// Mean ± std and max of a score's translational and rotational errors.
+fn errors(s: &relations::RelationsScore) -> String {
+    format!(
+        "{:.4} ± {:.4} m (max {:.3}), {:.3} ± {:.3} deg (max {:.2})",
+        s.translation.mean,
+        s.translation.std,
+        s.translation.max,
+        s.rotation.mean.to_degrees(),
+        s.rotation.std.to_degrees(),
+        s.rotation.max.to_degrees()
+    )
 }

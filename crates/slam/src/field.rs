@@ -139,6 +139,8 @@ pub struct Field {
     occupied: Vec<(i32, i32, f32, f32, u32, [i16; 2])>,
     /// Build scratch: per block of [`BLOCK`]² window cells, whether some lookup may need it.
     needed: Vec<bool>,
+    /// Build scratch: the points of [`Field::build_near`].
+    near: Vec<(f64, f64, f64)>,
 }
 
 /// Side, in cells, of the blocks in which [`Field::build_near`] decides which surfels to compute.
@@ -231,14 +233,23 @@ impl Field {
     /// allocated tiles), with surfels within `reach` cells of each cell's centre. `lines` off: every
     /// surfel is a point (the cell mean), as GMapping measures.
     pub fn build(&mut self, map: &TileMap, cells: [i32; 4], reach: i32, lines: bool) {
-        self.build_near(map, cells, reach, lines, &[]);
+        self.build_near(map, cells, reach, lines, std::iter::empty());
     }
 
     /// As [`Field::build`], but only the surfels that a lookup within `radius` metres of one of the map-frame
     /// points `(x, y, radius)` of `near` can find are computed (all of them when `near` is empty); a lookup
     /// elsewhere finds no surface. Where a scan's end points cover a small part of a large window (a long-range
     /// lidar in a building), that is most of the build's work saved.
-    pub fn build_near(&mut self, map: &TileMap, cells: [i32; 4], reach: i32, lines: bool, near: &[(f64, f64, f64)]) {
+    pub fn build_near(
+        &mut self,
+        map: &TileMap,
+        cells: [i32; 4],
+        reach: i32,
+        lines: bool,
+        near: impl IntoIterator<Item = (f64, f64, f64)>,
+    ) {
+        self.near.clear();
+        self.near.extend(near);
         let [mut cx0, mut cy0, mut cx1, mut cy1] = cells;
         if let Some([mx0, my0, mx1, my1]) = map.cell_bounds() {
             cx0 = cx0.max(mx0);
@@ -326,8 +337,8 @@ impl Field {
         // The blocks whose occupied cells can reach a lookup near one of the points.
         let (bw, bh) = ((self.w + BLOCK - 1) / BLOCK, (self.h + BLOCK - 1) / BLOCK);
         self.needed.clear();
-        self.needed.resize((bw * bh) as usize, near.is_empty());
-        for &(x, y, r) in near {
+        self.needed.resize((bw * bh) as usize, self.near.is_empty());
+        for &(x, y, r) in &self.near {
             let (u, v) = (x * self.inv_delta - cx0 as f64, y * self.inv_delta - cy0 as f64);
             let rc = r * self.inv_delta + (reach + 1) as f64;
             let lo = |c: f64, n: i32| (((c - rc).floor() as i32).div_euclid(BLOCK)).clamp(0, n - 1);

@@ -37,12 +37,22 @@ impl MotionModel {
         self.draw_increment(rng, p, dx, dy, dt)
     }
 
+    /// Standard deviations (x, y, θ) of the noise on an increment (dx, dy, dθ) in the robot's frame.
+    pub fn sigmas(&self, dx: f64, dy: f64, dt: f64) -> [f64; 3] {
+        let sxy = 0.3 * self.srr;
+        [
+            self.srr * dx.abs() + self.str * dt.abs() + sxy * dy.abs(),
+            self.srr * dy.abs() + self.str * dt.abs() + sxy * dx.abs(),
+            self.stt * dt.abs() + self.srt * dx.hypot(dy),
+        ]
+    }
+
     /// Samples `p ⊕ noisy(dx, dy, dθ)` for an increment given in the robot's frame.
     pub fn draw_increment<R: Rng>(&self, rng: &mut R, p: &Pose2, dx: f64, dy: f64, dt: f64) -> Pose2 {
-        let sxy = 0.3 * self.srr;
-        let nx = dx + gaussian(rng, self.srr * dx.abs() + self.str * dt.abs() + sxy * dy.abs());
-        let ny = dy + gaussian(rng, self.srr * dy.abs() + self.str * dt.abs() + sxy * dx.abs());
-        let nt = dt + gaussian(rng, self.stt * dt.abs() + self.srt * dx.hypot(dy));
+        let [sx, sy, st] = self.sigmas(dx, dy, dt);
+        let nx = dx + gaussian(rng, sx);
+        let ny = dy + gaussian(rng, sy);
+        let nt = dt + gaussian(rng, st);
         p * pose(nx, ny, normalize_angle(nt))
     }
 }

@@ -10,7 +10,7 @@ use crate::resample::{normalize, systematic};
 use crate::scan_matcher::{MatchResult, MotionPrior, PreparedScan, ScanMatcher, Scratch, Xyt};
 use crate::scan_odometry::ScanOdometry;
 use mrslam_core::pose::{pose_xyt, relative};
-use mrslam_core::{LaserScan, OccupancyGrid, Odometry, Pose2, pose};
+use mrslam_core::{LaserScan, OccupancyGrid, Odometry, Pose2};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
@@ -153,25 +153,14 @@ pub struct Rbpf {
     calibration: OdometryCalibration,
     /// Scan-matched odometry (see [`SlamParams::scan_odometry`]).
     scan_odometry: Option<ScanOdometry>,
-    /// The odometry pose of the last reading as the filter used it.
-    odometry: Option<Pose2>,
     counters: Counters,
-}
-
-fn to_xyt(p: &Pose2) -> Xyt {
-    let (x, y, t) = pose_xyt(p);
-    Xyt { x, y, t }
-}
-
-fn to_pose(p: &Xyt) -> Pose2 {
-    pose(p.x, p.y, p.t)
 }
 
 impl Rbpf {
     /// A filter with `params`, a laser mounted at `laser_offset` on the robot, and a seeded RNG.
     pub fn new(params: SlamParams, laser_offset: Pose2, seed: u64) -> Result<Self, SlamError> {
         params.validate().map_err(SlamError::BadParams)?;
-        let laser = to_xyt(&laser_offset);
+        let laser = Xyt::from_pose(&laser_offset);
         if !(laser.x.is_finite() && laser.y.is_finite() && laser.t.is_finite()) {
             return Err(SlamError::BadLaserOffset);
         }
@@ -198,7 +187,6 @@ impl Rbpf {
             motion_var: [0.0; 3],
             calibration: OdometryCalibration::default(),
             scan_odometry,
-            odometry: None,
             counters: Counters::default(),
         })
     }
@@ -209,9 +197,9 @@ impl Rbpf {
     }
 
     /// The odometry pose of the last reading as the filter used it: the scan-matched one when
-    /// `scan_odometry` is on (in its own frame), else the reading's.
+    /// `scan_odometry` is on (in its own frame), else the reading's; None until a scan with beams came.
     pub fn odometry_pose(&self) -> Option<Pose2> {
-        self.odometry
+        self.odo_pose
     }
 
     /// Scans the scan odometry matched and scans whose raw increment it kept; zeros when off.
@@ -238,7 +226,6 @@ impl Rbpf {
             }
             None => odom,
         };
-        self.odometry = Some(odom.pose);
         self.last_odom_stamp = Some(odom.stamp);
         self.last_scan_stamp = Some(scan.stamp);
         self.counters.readings += 1;
@@ -262,15 +249,12 @@ impl Rbpf {
             raw
         };
         for p in &mut self.particles {
-            let moved = self.motion.draw_increment(&mut self.rng, &to_pose(&p.pose), dx, dy, dt);
-            p.pose = to_xyt(&moved);
+            let moved = self.motion.draw_increment(&mut self.rng, &p.pose.to_pose(), dx, dy, dt);
+            p.pose = Xyt::from_pose(&moved);
         }
         self.linear_distance += raw.0.hypot(raw.1);
         self.angular_distance += raw.2.abs();
-        let m = &self.motion;
-        let sx = m.srr * dx.abs() + m.str * dt.abs() + 0.3 * m.srr * dy.abs();
-        let sy = m.srr * dy.abs() + m.str * dt.abs() + 0.3 * m.srr * dx.abs();
-        let st = m.stt * dt.abs() + m.srt * dx.hypot(dy);
+        let [sx, sy, st] = self.motion.sigmas(dx, dy, dt);
         self.motion_var[0] += sx * sx;
         self.motion_var[1] += sy * sy;
         self.motion_var[2] += st * st;
@@ -509,12 +493,12 @@ impl Rbpf {
 
     /// Current pose of the best particle (map frame), including motion since the last processed scan.
     pub fn best_pose(&self) -> Pose2 {
-        to_pose(&self.particles[self.best_index()].pose)
+        self.particles[self.best_index()].pose.to_pose()
     }
 
     /// The particles' current poses and normalised weights (for visualisation).
     pub fn particles(&self) -> impl Iterator<Item = (Pose2, f64)> + '_ {
-        self.particles.iter().zip(&self.weights).map(|(p, &w)| (to_pose(&p.pose), w))
+        self.particles.iter().zip(&self.weights).map(|(p, &w)| (p.pose.to_pose(), w))
     }
 
     /// Effective sample size of the current normalised weights (N right after a resampling).
@@ -540,7 +524,7 @@ impl Rbpf {
     /// Particle `i`'s path (see [`Rbpf::trajectory`]); empty when there is no such particle.
     pub fn particle_trajectory(&self, i: usize) -> Vec<(f64, Pose2)> {
         let Some(p) = self.particles.get(i) else { return Vec::new() };
-        let mut v: Vec<(f64, Pose2)> = ancestry(&p.node).map(|n| (n.stamp, to_pose(&n.pose))).collect();
+        let mut v: Vec<(f64, Pose2)> = ancestry(&p.node).map(|n| (n.stamp, n.pose.to_pose())).collect();
         v.reverse();
         v
     }

@@ -38,6 +38,19 @@ pub struct Xyt {
     pub t: f64,
 }
 
+impl Xyt {
+    /// The (x, y, θ) of a pose.
+    pub fn from_pose(p: &mrslam_core::Pose2) -> Self {
+        let (x, y, t) = mrslam_core::pose::pose_xyt(p);
+        Xyt { x, y, t }
+    }
+
+    /// The pose of (x, y, θ).
+    pub fn to_pose(&self) -> mrslam_core::Pose2 {
+        mrslam_core::pose(self.x, self.y, self.t)
+    }
+}
+
 /// Metres around the scan's end points (at the starting pose) that the likelihood field covers beyond them:
 /// how far the optimiser may move an end point and still find the field.
 const FIELD_MARGIN: f64 = 0.5;
@@ -262,6 +275,8 @@ pub struct MatchResult {
     pub likelihood: f64,
     /// Whether the matched pose was accepted (score > minimum score).
     pub accepted: bool,
+    /// Beams of the likelihood that found a surface at `pose`.
+    pub matched: usize,
     /// `field` matcher with [`ScanMatcher::information`] on: the scan's information about the pose at `pose`
     /// ([`ScanMatcher::scan_information`]) and the motion prior's (zero without one), map frame, upper
     /// triangles 00 01 02 11 12 22.
@@ -349,7 +364,7 @@ impl ScanMatcher {
                 let accepted = score > self.minimum_score;
                 let pose = if accepted { corrected } else { *init };
                 let e = self.likelihood_and_score(map, &pose, weigh);
-                MatchResult { pose, score, likelihood: e.likelihood, accepted, information: None }
+                MatchResult { pose, score, likelihood: e.likelihood, accepted, matched: e.matched, information: None }
             }
             MatcherKind::Field => {
                 self.build_field(map, init, scan, &mut scratch.field);
@@ -384,7 +399,7 @@ impl ScanMatcher {
                 let information = self.information.then(|| {
                     (self.scan_information(f, &pose, &scan.matched), prior.as_ref().map_or([0.0; 6], |p| p.info))
                 });
-                MatchResult { pose, score, likelihood: e.likelihood, accepted, information }
+                MatchResult { pose, score, likelihood: e.likelihood, accepted, matched: e.matched, information }
             }
         }
     }
@@ -404,15 +419,14 @@ impl ScanMatcher {
         // Where the matcher may move each end point: the margin, plus the arc of the heading search and of
         // the climb's first angular steps at its range.
         let turn = self.heading_search + 2.0 * self.astep;
-        let near: Vec<(f64, f64, f64)> = scan
+        let near = scan
             .hits
             .iter()
             .chain(&scan.matched)
-            .map(|b| (lp.x + c * b.x - s * b.y, lp.y + s * b.x + c * b.y, FIELD_MARGIN + b.r * turn))
-            .collect();
+            .map(|b| (lp.x + c * b.x - s * b.y, lp.y + s * b.x + c * b.y, FIELD_MARGIN + b.r * turn));
         let (a, b) = map.cell_of(x0 - FIELD_MARGIN, y0 - FIELD_MARGIN);
         let (c, d) = map.cell_of(x1 + FIELD_MARGIN, y1 + FIELD_MARGIN);
-        field.build_near(map, [a, b, c, d], self.field_reach, self.field_lines, &near);
+        field.build_near(map, [a, b, c, d], self.field_reach, self.field_lines, near);
     }
 
     /// Score, log-likelihood and matched beams of robot pose `p` on a likelihood field.
@@ -866,7 +880,7 @@ mod tests {
         use rand::SeedableRng;
         use rand_distr::{Distribution, Normal};
         let office = synthetic::office_map();
-        let lidar = Lidar { fov: std::f64::consts::PI, beams: 181, range_max: 20.0, ..Lidar::hokuyo() };
+        let lidar = Lidar::sick();
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(4);
         let at = |x: f64| mrslam_core::pose(x, 2.0, 0.02);
         // GMapping's hill climber has a narrow basin (its first steps are 5 cm and 0.05 rad) and stops at a

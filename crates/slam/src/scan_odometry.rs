@@ -19,6 +19,7 @@
 //! (GMapping's noise model over that increment, with floors), so a direction the scan does not observe
 //! (along a featureless corridor) keeps the odometry's increment.
 
+use crate::motion::MotionModel;
 use crate::params::{MatcherKind, SlamParams};
 use crate::scan_matcher::{MotionPrior, PreparedScan, ScanMatcher, Scratch, Xyt};
 use crate::tile_map::TileMap;
@@ -56,8 +57,8 @@ pub struct ScanOdometry {
     last_raw: Option<Pose2>,
     /// The corrected pose of the last scan (the local map's frame).
     pose: Xyt,
-    /// GMapping's noise coefficients srr, srt, str, stt for the prior.
-    noise: [f64; 4],
+    /// GMapping's noise model, for the prior.
+    noise: MotionModel,
     scratch: Scratch,
     /// Scans inserted so far.
     inserted: usize,
@@ -81,6 +82,8 @@ impl ScanOdometry {
             minimum_score: 0.0,
             frontier_guard: false,
             odometry_calibration: 0.0,
+            weight_all_beams: false,
+            kernel_likelihood: false,
             ..params.clone()
         };
         ScanOdometry {
@@ -92,7 +95,7 @@ impl ScanOdometry {
             submaps: [(TileMap::new(params.delta), 0), (TileMap::new(params.delta), 0)],
             last_raw: None,
             pose: Xyt { x: 0.0, y: 0.0, t: 0.0 },
-            noise: [params.srr, params.srt, params.str, params.stt],
+            noise: MotionModel { srr: params.srr, srt: params.srt, str: params.str, stt: params.stt },
             scratch: Scratch::default(),
             inserted: 0,
             matched: 0,
@@ -106,27 +109,23 @@ impl ScanOdometry {
         let prepared = PreparedScan::new(scan, self.max_range.min(scan.range_max as f64), self.max_urange, 0);
         let step = match self.last_raw {
             None => {
-                let (x, y, t) = pose_xyt(raw);
-                self.pose = Xyt { x, y, t };
+                self.pose = Xyt::from_pose(raw);
                 OdometryStep::First
             }
             Some(last) => {
                 let (dx, dy, dt) = pose_xyt(&relative(&last, raw));
-                let predicted = Self::to_xyt(&(Self::to_pose(&self.pose) * pose(dx, dy, dt)));
-                let [srr, srt, str, stt] = self.noise;
+                let predicted = Xyt::from_pose(&(self.pose.to_pose() * pose(dx, dy, dt)));
+                let [sx, sy, st] = self.noise.sigmas(dx, dy, dt);
                 let prior = MotionPrior {
-                    sx: (srr * dx.abs() + str * dt.abs() + 0.3 * srr * dy.abs()).max(MIN_PRIOR_SIGMA[0]),
-                    sy: (srr * dy.abs() + str * dt.abs() + 0.3 * srr * dx.abs()).max(MIN_PRIOR_SIGMA[1]),
-                    st: (stt * dt.abs() + srt * dx.hypot(dy)).max(MIN_PRIOR_SIGMA[2]),
+                    sx: sx.max(MIN_PRIOR_SIGMA[0]),
+                    sy: sy.max(MIN_PRIOR_SIGMA[1]),
+                    st: st.max(MIN_PRIOR_SIGMA[2]),
                 };
                 let older = if self.submaps[0].1 >= self.submaps[1].1 { 0 } else { 1 };
                 let map = &self.submaps[older].0;
                 let matched = (!prepared.matched.is_empty())
                     .then(|| self.matcher.match_scan(map, &predicted, &prepared, Some(&prior), &mut self.scratch))
-                    .filter(|m| {
-                        let found = self.matcher.field_eval(&self.scratch.field, &m.pose, &prepared.matched).matched;
-                        m.accepted && found as f64 >= MIN_MATCHED_FRACTION * prepared.matched.len() as f64
-                    });
+                    .filter(|m| m.accepted && m.matched as f64 >= MIN_MATCHED_FRACTION * prepared.matched.len() as f64);
                 if let Some(m) = matched {
                     self.pose = m.pose;
                     self.matched += 1;
@@ -140,7 +139,7 @@ impl ScanOdometry {
         };
         self.last_raw = Some(*raw);
         self.insert(&prepared);
-        (Self::to_pose(&self.pose), step)
+        (self.pose.to_pose(), step)
     }
 
     /// Inserts the scan's hits at the current pose into the submaps, replacing a full one by an empty one.
@@ -170,15 +169,6 @@ impl ScanOdometry {
     pub fn counts(&self) -> (usize, usize) {
         (self.matched, self.dead)
     }
-
-    fn to_xyt(p: &Pose2) -> Xyt {
-        let (x, y, t) = pose_xyt(p);
-        Xyt { x, y, t }
-    }
-
-    fn to_pose(p: &Xyt) -> Pose2 {
-        pose(p.x, p.y, p.t)
-    }
 }
 
 #[cfg(test)]
@@ -186,11 +176,6 @@ mod tests {
     use super::*;
     use crate::synthetic::{self, Drift, Lidar};
     use mrslam_core::pose::normalize_angle;
-
-    /// A SICK-class lidar as on the benchmark logs' robots: 181 beams over 180°, 20 m, 1 cm noise.
-    fn sick() -> Lidar {
-        Lidar { fov: std::f64::consts::PI, beams: 181, range_max: 20.0, ..Lidar::hokuyo() }
-    }
 
     /// (translation m, rotation rad) of the error of the end pose relative to the start pose.
     fn end_error(est: &[Pose2], truth: &[Pose2]) -> (f64, f64) {
@@ -205,7 +190,7 @@ mod tests {
             synthetic::waypoint_path(&synthetic::office_loop(), 0.05, 0.05).into_iter().take(500).collect();
         let drift = Drift { scale: 0.05, heading_per_m: 0.05, sigma_trans: 0.05, sigma_rot: 0.05 };
         let mut run =
-            synthetic::simulate(&synthetic::office_map(), &path, 0.1, &sick(), pose(0.1, 0.0, 0.0), &drift, 7);
+            synthetic::simulate(&synthetic::office_map(), &path, 0.1, &Lidar::sick(), pose(0.1, 0.0, 0.0), &drift, 7);
         // The heading glitch of a real log (Freiburg 079 at 1380 s): while the robot turns on the spot at the
         // first corner, the odometry's heading lags the truth by 0.03 rad per scan for 30 scans.
         let turn = (1..path.len())

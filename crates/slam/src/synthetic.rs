@@ -54,6 +54,11 @@ impl Lidar {
         Lidar { sigma_per_m: 0.005, dropout: 0.002, ..Self::hokuyo() }
     }
 
+    /// SICK LMS class, as on the benchmark logs' robots: 180°, 181 beams (1°), 20 m here, 1 cm noise.
+    pub fn sick() -> Self {
+        Lidar { fov: std::f64::consts::PI, beams: 181, range_max: 20.0, ..Self::hokuyo() }
+    }
+
     /// RpLidar A1 class: 360°, 360 beams, 6 m, 1 cm noise.
     pub fn rplidar() -> Self {
         Lidar {

@@ -333,16 +333,11 @@ fn odometry_calibration_learns_the_drift_and_is_off_by_default() {
     assert_eq!(f.odometry_calibration(), [0.0, 0.0]);
 }
 
-/// A SICK-class lidar as on the benchmark logs' robots: 181 beams over 180°, 20 m, 1 cm noise.
-fn sick() -> Lidar {
-    Lidar { fov: std::f64::consts::PI, beams: 181, range_max: 20.0, ..Lidar::hokuyo() }
-}
-
 /// The office loop with the SICK-class lidar and odometry that drifts a metre per lap.
 fn sick_office_run(seed: u64) -> SyntheticRun {
     let path = synthetic::waypoint_path(&synthetic::office_loop(), 0.05, 0.1);
     let drift = Drift { scale: 0.03, heading_per_m: 0.02, sigma_trans: 0.05, sigma_rot: 0.05 };
-    synthetic::simulate(&synthetic::office_map(), &path, 0.1, &sick(), pose(0.1, 0.0, 0.0), &drift, seed)
+    synthetic::simulate(&synthetic::office_map(), &path, 0.1, &Lidar::sick(), pose(0.1, 0.0, 0.0), &drift, seed)
 }
 
 #[test]
