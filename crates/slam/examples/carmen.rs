@@ -55,28 +55,21 @@ fn main() {
     }
     let secs = t.elapsed().as_secs_f64();
     let stamps: Vec<f64> = log.scans.iter().map(|r| r.scan.stamp).collect();
-    if std::env::var("ODOMETRY_ONLY").is_ok() {
-        let traj: Vec<StampedPose> =
-            stamps.iter().zip(&odometry).map(|(&stamp, &pose)| StampedPose { stamp, pose }).collect();
-        let s = relations::score(&traj, &rels, 0.001);
-        println!("odometry alone: {}, scan odometry {:?}", errors(&s), f.scan_odometry_counts());
-    }
     let anchors: Vec<(usize, Pose2)> = processed.iter().copied().zip(f.trajectory().into_iter().map(|k| k.1)).collect();
     let poses = poses_at_every_scan(&stamps, &odometry, &anchors).expect("processed scans");
     let traj: Vec<StampedPose> = stamps.iter().zip(poses).map(|(&stamp, pose)| StampedPose { stamp, pose }).collect();
     let s = relations::score(&traj, &rels, 0.001);
     let c = f.counters();
-    let split = |long: bool| {
-        let e: Vec<_> = s.errors.iter().filter(|e| ((e.t2 - e.t1).abs() > 10.0) == long).collect();
-        let n = e.len().max(1) as f64;
-        (
-            e.len(),
-            e.iter().map(|e| e.translation).sum::<f64>() / n,
-            e.iter().map(|e| e.rotation).sum::<f64>().to_degrees() / n,
-        )
-    };
-    let (ns, ts, rs) = split(false);
-    let (nl, tl, rl) = split(true);
+    if std::env::var("ODOMETRY_ONLY").is_ok() {
+        let traj: Vec<StampedPose> =
+            stamps.iter().zip(&odometry).map(|(&stamp, &pose)| StampedPose { stamp, pose }).collect();
+        let s = relations::score(&traj, &rels, 0.001);
+        println!("odometry alone: {}, scan odometry {:?}", errors(&s), f.scan_odometry_counts());
+        let (ns, ts, rs) = split(&s, false);
+        println!("  odometry alone short (<=10 s) {ns}: {ts:.4} m {rs:.3} deg");
+    }
+    let (ns, ts, rs) = split(&s, false);
+    let (nl, tl, rl) = split(&s, true);
     println!("  short (<=10 s) {ns}: {ts:.4} m {rs:.3} deg; long {nl}: {tl:.4} m {rl:.3} deg");
     if std::env::var("WORST_ROT").is_ok() {
         let mut v = s.errors.clone();
@@ -122,5 +115,16 @@ fn errors(s: &relations::RelationsScore) -> String {
         s.rotation.mean.to_degrees(),
         s.rotation.std.to_degrees(),
         s.rotation.max.to_degrees()
+    )
+}
+
+/// Relations of at most (`long` false) or more than (true) 10 s: count, mean translation (m) and rotation (deg).
+fn split(s: &relations::RelationsScore, long: bool) -> (usize, f64, f64) {
+    let e: Vec<_> = s.errors.iter().filter(|e| ((e.t2 - e.t1).abs() > 10.0) == long).collect();
+    let n = e.len().max(1) as f64;
+    (
+        e.len(),
+        e.iter().map(|e| e.translation).sum::<f64>() / n,
+        e.iter().map(|e| e.rotation).sum::<f64>().to_degrees() / n,
     )
 }

@@ -141,6 +141,78 @@ pub struct Field {
     needed: Vec<bool>,
     /// Build scratch: the points of [`Field::build_near`].
     near: Vec<(f64, f64, f64)>,
+    /// Build scratch: each occupied cell's surfel and where it sits.
+    surfels: Vec<Placed>,
+}
+
+/// An occupied cell's surfel placed in the window: the cell (window coordinates) and its mean (metres from the
+/// window's origin; the contest for the cells around it measures from there), the surfel, and the penalty it
+/// carries in that contest.
+#[derive(Debug, Clone, Copy)]
+struct Placed {
+    wx: i32,
+    wy: i32,
+    mx: f32,
+    my: f32,
+    surfel: Surfel,
+    penalty: f32,
+}
+
+impl Placed {
+    /// No surfel (its occupied cell is not needed).
+    const NONE: Placed = Placed { wx: 0, wy: 0, mx: 0.0, my: 0.0, surfel: EMPTY, penalty: 0.0 };
+}
+
+/// The splat's view of a build: the window's size, the reach (cells, and squared metres), the cell size.
+#[derive(Debug, Clone, Copy)]
+struct Band {
+    w: i32,
+    reach: i32,
+    reach2: f32,
+    delta: f32,
+    stamp: u16,
+}
+
+impl Band {
+    /// Splats `surfels` onto the window's rows from `row0` on, whose cells and best distances are `cells` and
+    /// `best`: each cell within reach of a surfel's mean keeps the nearest of each orientation class.
+    fn splat(&self, surfels: &[Placed], row0: i32, cells: &mut [[Surfel; 2]], best: &mut [[f32; 2]]) {
+        let w = self.w as usize;
+        let row1 = row0 + (cells.len() / w.max(1)) as i32 - 1;
+        let d32 = self.delta;
+        for p in surfels {
+            let s = p.surfel;
+            if s.kind & Surfel::NONE != 0 {
+                continue;
+            }
+            let (ya, yb) = ((p.wy - self.reach).max(row0), (p.wy + self.reach).min(row1));
+            if ya > yb {
+                continue;
+            }
+            let class = usize::from(s.kind & Surfel::LINE != 0 && s.ny.unsigned_abs() > s.nx.unsigned_abs());
+            let (mx, my) = (p.mx, p.my);
+            let (xa, xb) = ((p.wx - self.reach).max(0), (p.wx + self.reach).min(self.w - 1));
+            for y in ya..=yb {
+                let cy = (y as f32 + 0.5) * d32 - my;
+                let row = (y - row0) as usize * w;
+                // the row's cells within reach: |cx| <= sqrt(reach² - cy²), rounded out by a cell
+                let half = (self.reach2 - cy * cy).max(0.0).sqrt() / d32;
+                let mxc = mx / d32 - 0.5;
+                let (xa, xb) = (xa.max((mxc - half).floor() as i32), xb.min((mxc + half).ceil() as i32));
+                for x in xa..=xb {
+                    let cx = (x as f32 + 0.5) * d32 - mx;
+                    let d2 = cx * cx + cy * cy;
+                    let i = row + x as usize;
+                    let slot = &mut cells[i][class];
+                    let b = &mut best[i][class];
+                    if d2 <= self.reach2 && (slot.stamp != self.stamp || d2 + p.penalty < *b) {
+                        *b = d2 + p.penalty;
+                        *slot = s;
+                    }
+                }
+            }
+        }
+    }
 }
 
 /// Side, in cells, of the blocks in which [`Field::build_near`] decides which surfels to compute.
@@ -352,11 +424,33 @@ impl Field {
             }
         }
 
-        // Pass 2: each occupied cell's surfel, splatted onto the cells within reach of its mean.
+        // Pass 2: each needed occupied cell's surfel (in parallel halves), then the surfels splatted onto the
+        // cells within reach of their means (in parallel bands of rows). Both split the work into disjoint
+        // parts processed in the same order as one pass would, so the field does not depend on the threads.
+        let mut surfels = std::mem::take(&mut self.surfels);
+        surfels.clear();
+        surfels.resize(self.occupied.len(), Placed::NONE);
+        let mid = surfels.len() / 2;
+        let (first, second) = surfels.split_at_mut(mid);
+        let this = &*self;
+        let geometry = (pad, pw, ph, bw, bh);
+        rayon::join(|| this.surfels_of(0, first, geometry, lines), || this.surfels_of(mid, second, geometry, lines));
         let reach2 = ((reach as f64 + 0.5) * delta).powi(2) as f32;
-        let point_penalty = (POINT_PENALTY * delta * delta) as f32;
-        let d32 = delta as f32;
-        for k in 0..self.occupied.len() {
+        let rows = self.h as usize / 2;
+        let w = self.w as usize;
+        let (cells_a, cells_b) = self.cells[..n].split_at_mut(rows * w);
+        let (best_a, best_b) = self.best[..n].split_at_mut(rows * w);
+        let band = Band { w: self.w, reach, reach2, delta: delta as f32, stamp: self.stamp };
+        rayon::join(|| band.splat(&surfels, 0, cells_a, best_a), || band.splat(&surfels, rows as i32, cells_b, best_b));
+        self.surfels = surfels;
+    }
+
+    /// The surfels of occupied cells `offset..offset + out.len()` into `out` ([`Placed::NONE`] where the cell's
+    /// block is not needed). `geometry`: padding, padded width and height, block columns and rows.
+    fn surfels_of(&self, offset: usize, out: &mut [Placed], geometry: (i32, i32, i32, i32, i32), lines: bool) {
+        let (pad, pw, ph, bw, bh) = geometry;
+        let point_penalty = (POINT_PENALTY * self.delta * self.delta) as f32;
+        for (k, slot) in (offset..).zip(out.iter_mut()) {
             let (ox, oy, mx, my, hits, dir) = self.occupied[k];
             let (bx, by) = (((ox - pad) / BLOCK).clamp(0, bw - 1), ((oy - pad) / BLOCK).clamp(0, bh - 1));
             if !self.needed[(by * bw + bx) as usize] {
@@ -388,30 +482,7 @@ impl Field {
                     stamp: self.stamp,
                 };
             }
-            let class = usize::from(s.kind & Surfel::LINE != 0 && s.ny.unsigned_abs() > s.nx.unsigned_abs());
-            // cells (window coordinates) within reach of the occupied cell
-            let (wx, wy) = (ox - pad, oy - pad);
-            let (xa, xb) = ((wx - reach).max(0), (wx + reach).min(self.w - 1));
-            let (ya, yb) = ((wy - reach).max(0), (wy + reach).min(self.h - 1));
-            for y in ya..=yb {
-                let cy = (y as f32 + 0.5) * d32 - my;
-                let row = (y * self.w) as usize;
-                // the row's cells within reach: |cx| <= sqrt(reach² - cy²), rounded out by a cell
-                let half = (reach2 - cy * cy).max(0.0).sqrt() / d32;
-                let mxc = mx / d32 - 0.5;
-                let (xa, xb) = (xa.max((mxc - half).floor() as i32), xb.min((mxc + half).ceil() as i32));
-                for x in xa..=xb {
-                    let cx = (x as f32 + 0.5) * d32 - mx;
-                    let d2 = cx * cx + cy * cy;
-                    let i = row + x as usize;
-                    let slot = &mut self.cells[i][class];
-                    let best = &mut self.best[i][class];
-                    if d2 <= reach2 && (slot.stamp != s.stamp || d2 + penalty < *best) {
-                        *best = d2 + penalty;
-                        *slot = s;
-                    }
-                }
-            }
+            *slot = Placed { wx: ox - pad, wy: oy - pad, mx, my, surfel: s, penalty };
         }
     }
 
@@ -606,5 +677,56 @@ mod tests {
                 other => panic!("{other:?}"),
             }
         }
+    }
+
+    /// A room with slanted walls and clutter, hit from inside.
+    fn cluttered_room() -> TileMap {
+        let mut m = TileMap::new(0.05);
+        for i in 0..400 {
+            let t = i as f64 * 0.01;
+            m.add_beam_hit(t, 0.0, 0.0, -1.0).unwrap();
+            m.add_beam_hit(t, 3.0 + 0.2 * t, 0.0, 1.0).unwrap();
+            m.add_beam_hit(0.0, t * 0.75, -1.0, 0.0).unwrap();
+            m.add_beam_hit(4.0, t * 0.8, 1.0, 0.0).unwrap();
+            m.add_beam_hit(1.5 + 0.3 * (t * 7.0).sin(), 1.5 + 0.3 * (t * 7.0).cos(), 1.0, 0.0).unwrap();
+        }
+        m
+    }
+
+    #[test]
+    fn the_parallel_build_equals_one_pass_and_a_reused_field_equals_a_fresh_one() {
+        let m = cluttered_room();
+        let mut reused = Field::default();
+        reused.build(&cluttered_room_other(), [-20, -20, 90, 90], 4, true);
+        reused.build(&m, [-10, -10, 90, 90], 4, true);
+        let mut fresh = Field::default();
+        fresh.build(&m, [-10, -10, 90, 90], 4, true);
+        let n = (fresh.w * fresh.h) as usize;
+        // one band over every row, from the same surfels
+        let mut cells = vec![[EMPTY; 2]; n];
+        let mut best = vec![[f32::INFINITY; 2]; n];
+        let reach2 = ((4.0 + 0.5) * fresh.delta).powi(2) as f32;
+        let band = Band { w: fresh.w, reach: 4, reach2, delta: fresh.delta as f32, stamp: fresh.stamp };
+        band.splat(&fresh.surfels, 0, &mut cells, &mut best);
+        assert_eq!(&fresh.cells[..n], &cells[..]);
+        assert!(cells.iter().flatten().any(|s| s.kind & Surfel::LINE != 0));
+        // the reused buffers give the same lookups as fresh ones
+        let (ox, oy) = fresh.origin();
+        assert_eq!(reused.origin(), (ox, oy));
+        for k in 0..2000 {
+            let (x, y) = (-0.3 + (k % 50) as f64 * 0.1, -0.3 + (k / 50) as f64 * 0.1);
+            let (dx, dy) = ((k as f64).cos(), (k as f64).sin());
+            assert_eq!(reused.lookup(x - ox, y - oy, dx, dy), fresh.lookup(x - ox, y - oy, dx, dy), "({x}, {y})");
+        }
+    }
+
+    /// Another map, so that a reused field holds stale surfels where the next build has none.
+    fn cluttered_room_other() -> TileMap {
+        let mut m = TileMap::new(0.05);
+        for i in 0..300 {
+            let t = i as f64 * 0.01;
+            m.add_beam_hit(t + 0.5, 2.0 - 0.5 * t, 0.0, 1.0).unwrap();
+        }
+        m
     }
 }

@@ -148,6 +148,9 @@ pub struct SlamParams {
     /// Not GMapping: `scan_odometry_heading_search`, radians: the scan odometry matcher tries headings within
     /// ± this of the odometry's before it climbs (0: off).
     pub scan_odometry_heading_search: f64,
+    /// Not GMapping: `scan_odometry_reach`, cells: the scan odometry's field reach (as `field_reach`). Its
+    /// increments are centimetres, so a short reach suffices, and its field is built for every scan.
+    pub scan_odometry_reach: i32,
     /// Not GMapping: `wall_hits`: in the output map a beam's free-space trace stops at the first cell on its
     /// way that at least this many beams ended in (see [`crate::map_build`]); 0: traces run to the end
     /// point, as GMapping's.
@@ -205,6 +208,7 @@ impl Default for SlamParams {
             scan_odometry_range: 30.0,
             scan_odometry_sigma: 0.001,
             scan_odometry_heading_search: 0.1,
+            scan_odometry_reach: 3,
             wall_hits: 0,
             kernel_likelihood: false,
         }
@@ -346,6 +350,9 @@ impl SlamParams {
             "scan_odometry_range" => self.scan_odometry_range = f()?,
             "scan_odometry_sigma" => self.scan_odometry_sigma = f()?,
             "scan_odometry_heading_search" => self.scan_odometry_heading_search = f()?,
+            "scan_odometry_reach" => {
+                self.scan_odometry_reach = value.trim().parse().map_err(|e| format!("{name}: {e}"))?
+            }
             "kernel_likelihood" => self.kernel_likelihood = b()?,
             "wall_hits" => self.wall_hits = value.trim().parse().map_err(|e| format!("{name}: {e} ('{value}')"))?,
             _ => return Err(format!("unknown SLAM parameter '{name}'")),
@@ -402,6 +409,9 @@ impl SlamParams {
         nonneg("unknown_score", self.unknown_score)?;
         if !(1..=16).contains(&self.field_reach) {
             return Err(format!("field_reach must be in 1..=16, got {}", self.field_reach));
+        }
+        if !(1..=16).contains(&self.scan_odometry_reach) {
+            return Err(format!("scan_odometry_reach must be in 1..=16, got {}", self.scan_odometry_reach));
         }
         nonneg("heading_search", self.heading_search)?;
         nonneg("motion_prior", self.motion_prior)?;

@@ -416,14 +416,21 @@ impl ScanMatcher {
             x1 = x1.max(px);
             y1 = y1.max(py);
         }
-        // Where the matcher may move each end point: the margin, plus the arc of the heading search and of
-        // the climb's first angular steps at its range.
+        // Where the matcher may move each end point: the arc it sweeps as the heading search and the climb's
+        // first angular steps turn the robot, widened by the margin. Sampled every margin along the arc, so
+        // the discs cover a band about the arc rather than the disc around the end point a long beam's arc
+        // spans (at 30 m, a band a metre wide instead of a disc 9 m across).
         let turn = self.heading_search + 2.0 * self.astep;
-        let near = scan
-            .hits
-            .iter()
-            .chain(&scan.matched)
-            .map(|b| (lp.x + c * b.x - s * b.y, lp.y + s * b.x + c * b.y, FIELD_MARGIN + b.r * turn));
+        let near = scan.hits.iter().flat_map(move |b| {
+            let (ex, ey) = (lp.x + c * b.x - s * b.y - p.x, lp.y + s * b.x + c * b.y - p.y);
+            let arm = ex.hypot(ey);
+            let k = (arm * turn / FIELD_MARGIN).ceil() as i32;
+            let step = if k > 0 { turn / k as f64 } else { 0.0 };
+            (-k..=k).map(move |i| {
+                let (si, ci) = (i as f64 * step).sin_cos();
+                (p.x + ci * ex - si * ey, p.y + si * ex + ci * ey, FIELD_MARGIN)
+            })
+        });
         let (a, b) = map.cell_of(x0 - FIELD_MARGIN, y0 - FIELD_MARGIN);
         let (c, d) = map.cell_of(x1 + FIELD_MARGIN, y1 + FIELD_MARGIN);
         field.build_near(map, [a, b, c, d], self.field_reach, self.field_lines, near);

@@ -84,6 +84,7 @@ impl ScanOdometry {
             odometry_calibration: 0.0,
             weight_all_beams: false,
             kernel_likelihood: false,
+            field_reach: params.scan_odometry_reach,
             ..params.clone()
         };
         ScanOdometry {
