@@ -170,6 +170,7 @@ fn a_log_split_into_two_robots_is_mapped_merged_scored_and_resumed() {
     assert!(text(&o.stderr).contains("--resume"), "{}", text(&o.stderr));
     // Resumed: the parts are read back, not mapped again; the same rows come out.
     let before = csv(&out.join("results.csv")).1;
+    let parts_before = std::fs::read_to_string(out.join("parts.csv")).unwrap();
     std::fs::remove_file(out.join("results.csv")).unwrap();
     let o = study(&f.log, &f.rels, "2", &out, &["--resume"]);
     assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
@@ -180,6 +181,7 @@ fn a_log_split_into_two_robots_is_mapped_merged_scored_and_resumed() {
         rows.iter().map(|r| r.split(',').enumerate().filter(|(i, _)| *i != k).map(|(_, f)| f).collect()).collect()
     };
     assert_eq!(strip(&before), strip(&after));
+    assert_eq!(std::fs::read_to_string(out.join("parts.csv")).unwrap(), parts_before, "the parts' SLAM counts kept");
     // A resume of another study (other seed) is refused.
     let o = study(&f.log, &f.rels, "2", &out, &["--resume", "--seed", "9"]);
     assert_eq!(o.status.code(), Some(1));

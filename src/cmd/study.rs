@@ -16,7 +16,7 @@ use mrslam_testbed::study::{
     self, Journal, MapSource, OverlapStudy, Progress, Shard, StudyError, StudyParams, Sweep, TrialRow, collect,
     parse_range, run_overlap_study, run_sweep, summary::table,
 };
-use std::collections::BTreeSet;
+use std::collections::{BTreeMap, BTreeSet};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -509,11 +509,18 @@ fn logs(a: LogsArgs) -> Result<ExitCode> {
     let start = Instant::now();
     let mut parts = Vec::with_capacity(a.parts);
     let mut parts_csv = String::from("part,first_stamp,last_stamp,scans,processed,slam_s,width,height,known_cells\n");
+    // A resumed study keeps what its parts.csv said of the parts it reads back (their SLAM counts and time).
+    let earlier: BTreeMap<usize, String> = std::fs::read_to_string(a.out.join("parts.csv"))
+        .unwrap_or_default()
+        .lines()
+        .skip(1)
+        .filter_map(|l| Some((l.split(',').next()?.parse().ok()?, format!("{l}\n"))))
+        .collect();
     for (k, range) in ranges.iter().enumerate() {
         let scans = &log.scans[range.clone()];
         let (map_path, traj_path) = part_files(&a.out, k);
         let (first, last) = (scans[0].scan.stamp, scans[scans.len() - 1].scan.stamp);
-        let part = if a.resume && map_path.exists() && traj_path.exists() {
+        let (part, line) = if a.resume && map_path.exists() && traj_path.exists() {
             let map = map_io::read_ros_map(&map_path).with_context(|| format!("{}", map_path.display()))?;
             let trajectory = relations::read_trajectory(&traj_path)?;
             println!(
@@ -521,7 +528,7 @@ fn logs(a: LogsArgs) -> Result<ExitCode> {
                 scans.len(),
                 map_path.display()
             );
-            logs::PartMap { map, trajectory, processed: 0, seconds: 0.0 }
+            (logs::PartMap { map, trajectory, processed: 0, seconds: 0.0 }, earlier.get(&k).cloned())
         } else {
             let bar = ProgressBar::new(scans.len() as u64);
             if a.quiet || !std::io::stderr().is_terminal() {
@@ -556,22 +563,24 @@ fn logs(a: LogsArgs) -> Result<ExitCode> {
             // that a resumed study computes exactly the rows of an uninterrupted one.
             let map = map_io::read_ros_map(&map_path).with_context(|| format!("{}", map_path.display()))?;
             let trajectory = relations::read_trajectory(&traj_path)?;
-            logs::PartMap { map, trajectory, ..part }
+            (logs::PartMap { map, trajectory, ..part }, None)
         };
         let (free, occ, _) = part.map.state_counts();
-        parts_csv += &format!(
-            "{k},{first:.6},{last:.6},{},{},{:.3},{},{},{}\n",
-            scans.len(),
-            part.processed,
-            part.seconds,
-            part.map.width(),
-            part.map.height(),
-            free + occ
-        );
+        parts_csv += &line.unwrap_or_else(|| {
+            format!(
+                "{k},{first:.6},{last:.6},{},{},{:.3},{},{},{}\n",
+                scans.len(),
+                part.processed,
+                part.seconds,
+                part.map.width(),
+                part.map.height(),
+                free + occ
+            )
+        });
+        // Rewritten after each part, so that a resume knows what the parts it reads back cost.
+        write_file_atomic(&a.out.join("parts.csv"), parts_csv.as_bytes())?;
         parts.push(part);
     }
-    let parts_path = a.out.join("parts.csv");
-    write_file_atomic(&parts_path, parts_csv.as_bytes())?;
 
     let trajectories: Vec<&[relations::StampedPose]> = parts.iter().map(|p| p.trajectory.as_slice()).collect();
     let cross = logs::cross_relations(&rels, &trajectories, a.tolerance);
