@@ -7,6 +7,7 @@ use clap::{Args, Subcommand};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use mrslam_core::map_io::{self, write_file_atomic};
 use mrslam_core::relations;
+use mrslam_merge::MapEncoding;
 use mrslam_merge::floorplan::FloorplanParams;
 use mrslam_slam::Preset;
 use mrslam_testbed::study::journal::{collect_params, fingerprint};
@@ -150,6 +151,10 @@ pub struct LogsArgs {
     /// Algorithms, comma-separated (sift, rmap).
     #[arg(long, default_value = "sift,rmap", value_delimiter = ',')]
     pub algorithms: Vec<String>,
+    /// The SIFT merger's map-to-image encoding: `walls` (free and unknown alike, the default) or `paper`
+    /// (unknown grey, the paper's).
+    #[arg(long, default_value = "walls", value_parser = ["walls", "paper"])]
+    pub encoding: String,
     /// Seed of the SLAM filter (every part) and of the mergers' draws.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
@@ -475,6 +480,7 @@ fn logs(a: LogsArgs) -> Result<ExitCode> {
         .set("slam_set", a.slam_set.join(" "))
         .set("seed", a.seed)
         .set("algorithms", algorithms.iter().map(|x| x.name()).collect::<Vec<_>>().join(","))
+        .set("encoding", &a.encoding)
         .set("tolerance", a.tolerance)
         .set("max_error_m", a.max_error_m)
         .set("max_error_deg", a.max_error_deg);
@@ -598,7 +604,8 @@ fn logs(a: LogsArgs) -> Result<ExitCode> {
             a.tolerance
         );
     }
-    let score = ScoreParams { max_error_m: a.max_error_m, max_error_deg: a.max_error_deg, seed: a.seed };
+    let encoding = if a.encoding == "paper" { MapEncoding::PAPER } else { MapEncoding::WALLS };
+    let score = ScoreParams { max_error_m: a.max_error_m, max_error_deg: a.max_error_deg, seed: a.seed, encoding };
     let mut rows: Vec<PairRow> = Vec::new();
     for (&(i, j), c) in &cross {
         for &alg in &algorithms {

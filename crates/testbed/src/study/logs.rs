@@ -11,13 +11,13 @@
 //! it is reported beside each merge as the floor.
 
 use super::StudyError;
-use super::algorithms::study_merger;
+use super::algorithms::study_merger_encoded;
 use super::results::TrialRow;
 use crate::eval::transform_error;
 use mrslam_core::pose::{normalize_angle, pose, pose_xyt};
 use mrslam_core::relations::{Relation, StampedPose, pose_at};
 use mrslam_core::{CellState, OccupancyGrid, Pose2, ScanRecord};
-use mrslam_merge::{Algorithm, MergeParams, merge};
+use mrslam_merge::{Algorithm, MapEncoding, MergeParams, merge};
 use mrslam_slam::{Rbpf, SlamParams, poses_at_every_scan};
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
@@ -295,11 +295,18 @@ pub struct ScoreParams {
     pub max_error_deg: f64,
     /// Seed of the mergers' random draws.
     pub seed: u64,
+    /// The SIFT merger's map-to-image encoding.
+    pub encoding: MapEncoding,
 }
 
 impl Default for ScoreParams {
     fn default() -> Self {
-        ScoreParams { max_error_m: MAX_ERROR_M, max_error_deg: MAX_ERROR_DEG, seed: 0 }
+        ScoreParams {
+            max_error_m: MAX_ERROR_M,
+            max_error_deg: MAX_ERROR_DEG,
+            seed: 0,
+            encoding: MapEncoding::default(),
+        }
     }
 }
 
@@ -434,7 +441,7 @@ pub fn merge_pair(
         .ok_or_else(|| StudyError::Invalid(format!("parts {i} and {j}: no relation connects them")))?;
     let truth_error = median_error(&truth, cross).unwrap_or((f64::NAN, f64::NAN));
     let (overlap, overlap_smaller) = overlap(a, b, &truth);
-    let merger = study_merger(algorithm, p.seed);
+    let merger = study_merger_encoded(algorithm, p.seed, p.encoding);
     let out = merge(merger.as_ref(), a, b, &MergeParams::default());
     let r = out.report;
     let estimate = r.transform.map(|x| x.to_pose());

@@ -88,7 +88,7 @@ pub trait Progress: Sync {
 /// No resume, nothing reported.
 impl Progress for () {}
 
-pub use algorithms::{check_algorithms, parse_algorithms, study_merger};
+pub use algorithms::{check_algorithms, parse_algorithms, study_merger, study_merger_encoded};
 pub use journal::{Journal, StudyParams};
 pub use overlap::{MapSource, OverlapStudy, run_overlap_study};
 pub use range::parse_range;
