@@ -1,6 +1,6 @@
 //! The merge algorithms a study compares, built for one trial.
 
-use mrslam_merge::{Algorithm, Merger, RmapMerger, RmapParams, SiftMerger, SiftMergerParams};
+use mrslam_merge::{Algorithm, MapEncoding, Merger, RmapMerger, RmapParams, SiftMerger, SiftMergerParams};
 
 /// `algorithm`'s merger with default parameters for a map-level trial seeded `seed`.
 ///
@@ -8,9 +8,14 @@ use mrslam_merge::{Algorithm, Merger, RmapMerger, RmapParams, SiftMerger, SiftMe
 /// default seed ([`RmapParams::default`], 0) in every trial, as the published studies were computed. A
 /// simulated run ([`crate::runner::merger_for`]) seeds both with the scenario's seed.
 pub fn study_merger(algorithm: Algorithm, seed: u64) -> Box<dyn Merger> {
+    study_merger_encoded(algorithm, seed, MapEncoding::default())
+}
+
+/// [`study_merger`] with the SIFT merger's map-to-image encoding chosen (the R-map merger has none).
+pub fn study_merger_encoded(algorithm: Algorithm, seed: u64, encoding: MapEncoding) -> Box<dyn Merger> {
     match algorithm {
         Algorithm::Sift => {
-            let mut p = SiftMergerParams::default();
+            let mut p = SiftMergerParams { encoding, ..SiftMergerParams::default() };
             p.ransac.seed = seed;
             Box::new(SiftMerger::new(p))
         }

@@ -8,6 +8,10 @@
 //!   reaches); each variant runs the whole simulation, SLAM and merge, and its overlap is the one the
 //!   robots actually observed.
 //!
+//! A third kind, **real data** ([`logs`]), splits a real robot's log in time into parts ("robots"), maps each
+//! part with the SLAM, merges the pairs that benchmark relations connect and scores them against the
+//! relations; it writes its own `results.csv` columns (one row per pair and algorithm).
+//!
 //! Rows go to `results.csv` ([`results`]); [`summary`] bins them by overlap with Wilson intervals
 //! ([`wilson`]) into `summary.csv`; [`plot`] draws `plot.png`. [`shard`] splits one study across processes
 //! and [`results::collect`] joins the shards again. Every trial is seeded from (study seed, overlap index,
@@ -15,6 +19,7 @@
 
 pub mod algorithms;
 pub mod journal;
+pub mod logs;
 pub mod overlap;
 pub mod plot;
 pub mod range;
@@ -83,7 +88,7 @@ pub trait Progress: Sync {
 /// No resume, nothing reported.
 impl Progress for () {}
 
-pub use algorithms::{check_algorithms, parse_algorithms, study_merger};
+pub use algorithms::{check_algorithms, parse_algorithms, study_merger, study_merger_encoded};
 pub use journal::{Journal, StudyParams};
 pub use overlap::{MapSource, OverlapStudy, run_overlap_study};
 pub use range::parse_range;
