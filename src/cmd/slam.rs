@@ -12,7 +12,7 @@ use mrslam_core::map_io::{self, write_file_atomic};
 use mrslam_core::relations::{self, StampedPose};
 use mrslam_core::{Odometry, Pose2};
 use mrslam_slam::synthetic::{Drift, inject_drift};
-use mrslam_slam::{Preset, Rbpf, poses_at_every_scan};
+use mrslam_slam::{LogRunError, Preset, Rbpf, map_log};
 use serde_json::json;
 use std::io::IsTerminal;
 use std::path::PathBuf;
@@ -144,34 +144,26 @@ pub fn run(args: SlamArgs) -> Result<ExitCode> {
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
     let start = std::time::Instant::now();
-    let mut processed: Vec<usize> = Vec::new();
-    // The odometry as the filter used it (scan-matched when `scan_odometry` is on), to place skipped scans.
-    let mut odometry: Vec<Pose2> = Vec::with_capacity(log.scans.len());
-    for (i, (rec, o)) in log.scans.iter().zip(&odo).enumerate() {
-        let out = filter.process(o, &rec.scan).with_context(|| format!("{}:{}", args.log.display(), rec.line))?;
-        odometry.push(filter.odometry_pose().unwrap_or(o.pose));
+    let run = map_log(&mut filter, odo.iter().zip(log.scans.iter().map(|r| &r.scan)), |out| {
         if let Some(neff) = out.neff() {
             bar.set_message(format!("Neff {neff:.1}"));
         }
-        if out.is_processed() {
-            processed.push(i);
-        }
         bar.inc(1);
-    }
+    })
+    .map_err(|e| match e {
+        LogRunError::Reading { index, error } => {
+            anyhow::anyhow!("{}:{}: {error}", args.log.display(), log.scans[index].line)
+        }
+        LogRunError::NothingProcessed => anyhow::anyhow!("the filter processed no scan: no trajectory"),
+    })?;
     bar.finish_and_clear();
     let secs = start.elapsed().as_secs_f64();
     let map = filter.map().context("building the map")?;
     map_io::write_ros_map(&map, &args.output).with_context(|| format!("{}", args.output.display()))?;
 
     // A pose for every scan: the filter's at the processed ones, odometry in between.
-    let keyframes = filter.trajectory();
-    if keyframes.len() != processed.len() {
-        bail!("internal: {} trajectory nodes for {} processed scans", keyframes.len(), processed.len());
-    }
+    let (poses, processed) = (run.poses, run.processed);
     let stamps: Vec<f64> = log.scans.iter().map(|r| r.scan.stamp).collect();
-    let anchors: Vec<(usize, Pose2)> = processed.iter().copied().zip(keyframes.iter().map(|k| k.1)).collect();
-    let poses =
-        poses_at_every_scan(&stamps, &odometry, &anchors).context("the filter processed no scan: no trajectory")?;
     let trajectory: Vec<StampedPose> =
         stamps.iter().zip(&poses).map(|(&stamp, &pose)| StampedPose { stamp, pose }).collect();
     if let Some(path) = &args.trajectory {

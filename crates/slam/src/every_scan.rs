@@ -8,8 +8,61 @@
 //! Scans before the first processed scan are placed by odometry back from it, scans after the last by
 //! odometry from it.
 
-use mrslam_core::Pose2;
+use crate::{Rbpf, SlamError, UpdateOutcome};
 use mrslam_core::pose::interpolate;
+use mrslam_core::{LaserScan, Odometry, Pose2};
+
+/// What the filter made of a log: a pose for every scan, and which scans it processed.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LogRun {
+    /// The best particle's robot pose at every scan (see [`poses_at_every_scan`]).
+    pub poses: Vec<Pose2>,
+    /// Indices of the scans the filter processed.
+    pub processed: Vec<usize>,
+}
+
+/// Why [`map_log`] stopped.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum LogRunError {
+    /// The filter refused reading `index` (0-based, in the order given).
+    #[error("reading {index}: {error}")]
+    Reading {
+        /// The reading's index.
+        index: usize,
+        /// What the filter said.
+        error: SlamError,
+    },
+    /// No scan was processed (no scan had beams), so no scan has a pose.
+    #[error("the filter processed no scan")]
+    NothingProcessed,
+}
+
+/// Feeds `filter` a log's readings (each scan with its odometry, in order) and places every scan: the filter's
+/// pose at the processed ones, its odometry (scan-matched when `scan_odometry` is on) in between.
+/// `on_reading` sees each reading's outcome (for progress); the map is the filter's afterwards.
+pub fn map_log<'a>(
+    filter: &mut Rbpf,
+    readings: impl IntoIterator<Item = (&'a Odometry, &'a LaserScan)>,
+    mut on_reading: impl FnMut(&UpdateOutcome),
+) -> Result<LogRun, LogRunError> {
+    let mut processed = Vec::new();
+    let mut odometry = Vec::new();
+    let mut stamps = Vec::new();
+    for (index, (odom, scan)) in readings.into_iter().enumerate() {
+        let out = filter.process(odom, scan).map_err(|error| LogRunError::Reading { index, error })?;
+        odometry.push(filter.odometry_pose().unwrap_or(odom.pose));
+        stamps.push(scan.stamp);
+        if out.is_processed() {
+            processed.push(index);
+        }
+        on_reading(&out);
+    }
+    let keyframes = filter.trajectory();
+    debug_assert_eq!(keyframes.len(), processed.len(), "one trajectory node per processed scan");
+    let anchors: Vec<(usize, Pose2)> = processed.iter().copied().zip(keyframes.into_iter().map(|(_, p)| p)).collect();
+    let poses = poses_at_every_scan(&stamps, &odometry, &anchors).ok_or(LogRunError::NothingProcessed)?;
+    Ok(LogRun { poses, processed })
+}
 
 /// Poses for every scan, given each scan's stamp and odometry and the filter's poses at the processed
 /// scans as (index into the scans, pose), in increasing index order.

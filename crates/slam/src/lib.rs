@@ -30,6 +30,6 @@ pub mod synthetic;
 pub mod tile_map;
 
 pub use error::SlamError;
-pub use every_scan::poses_at_every_scan;
+pub use every_scan::{LogRun, LogRunError, map_log, poses_at_every_scan};
 pub use params::{Preset, SlamParams};
 pub use rbpf::{MemoryStats, Rbpf, SkipReason, UpdateOutcome, UpdateStats};

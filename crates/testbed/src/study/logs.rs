@@ -18,7 +18,7 @@ use mrslam_core::pose::{normalize_angle, pose, pose_xyt};
 use mrslam_core::relations::{Relation, StampedPose, pose_at};
 use mrslam_core::{CellState, OccupancyGrid, Pose2, ScanRecord};
 use mrslam_merge::{Algorithm, MapEncoding, MergeParams, merge};
-use mrslam_slam::{Rbpf, SlamParams, poses_at_every_scan};
+use mrslam_slam::{LogRunError, Rbpf, SlamParams, map_log};
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::ops::Range;
@@ -95,39 +95,23 @@ pub fn map_part(
     let start = std::time::Instant::now();
     let mut filter = Rbpf::new(params.clone(), first.laser_offset, seed)
         .map_err(|e| StudyError::Invalid(format!("slam parameters: {e}")))?;
-    let mut processed = Vec::new();
-    let mut odometry = Vec::with_capacity(scans.len());
-    for (i, rec) in scans.iter().enumerate() {
-        let out = filter
-            .process(&rec.odometry, &rec.scan)
-            .map_err(|e| StudyError::file(log, format!("line {}: {e}", rec.line)))?;
-        odometry.push(filter.odometry_pose().unwrap_or(rec.odometry.pose));
-        if out.is_processed() {
-            processed.push(i);
-        }
-        on_scan();
-    }
-    let map = filter.map().map_err(|e| StudyError::file(log, format!("building a part's map: {e}")))?;
-    let keyframes = filter.trajectory();
-    if keyframes.len() != processed.len() {
-        return Err(StudyError::Invalid(format!(
-            "internal: {} trajectory nodes for {} processed scans",
-            keyframes.len(),
-            processed.len()
-        )));
-    }
-    let stamps: Vec<f64> = scans.iter().map(|r| r.scan.stamp).collect();
-    let anchors: Vec<(usize, Pose2)> = processed.iter().copied().zip(keyframes.iter().map(|k| k.1)).collect();
-    let poses = poses_at_every_scan(&stamps, &odometry, &anchors).ok_or_else(|| {
-        StudyError::file(
-            log,
-            format!(
-                "lines {}..{}: the filter processed no scan of this part (the robot did not move enough?)",
-                first.line,
-                scans.last().map_or(first.line, |r| r.line)
+    let run =
+        map_log(&mut filter, scans.iter().map(|r| (&r.odometry, &r.scan)), |_| on_scan()).map_err(|e| match e {
+            LogRunError::Reading { index, error } => {
+                StudyError::file(log, format!("line {}: {error}", scans[index].line))
+            }
+            LogRunError::NothingProcessed => StudyError::file(
+                log,
+                format!(
+                    "lines {}..{}: the filter processed no scan of this part",
+                    first.line,
+                    scans.last().map_or(first.line, |r| r.line)
+                ),
             ),
-        )
-    })?;
+        })?;
+    let map = filter.map().map_err(|e| StudyError::file(log, format!("building a part's map: {e}")))?;
+    let (poses, processed) = (run.poses, run.processed);
+    let stamps: Vec<f64> = scans.iter().map(|r| r.scan.stamp).collect();
     let trajectory = stamps.iter().zip(poses).map(|(&stamp, pose)| StampedPose { stamp, pose }).collect();
     Ok(PartMap { map, trajectory, processed: processed.len(), seconds: start.elapsed().as_secs_f64() })
 }
