@@ -181,9 +181,9 @@ pub fn merge_many(merger: &dyn Merger, maps: &[OccupancyGrid], params: &MergePar
     let not_connected: Vec<usize> = (0..n).filter(|i| !joined.contains(i)).collect();
     // Fused in tree order (breadth first from map 0): each map lands next to maps already in.
     let merged = (joined.len() > 1).then(|| {
-        tree.iter().filter(|e| joined.contains(&e.child)).fold(maps[0].clone(), |acc, e| {
-            fuse(&acc, &maps[e.child], &to_root[e.child], params.fusion)
-        })
+        tree.iter()
+            .filter(|e| joined.contains(&e.child))
+            .fold(maps[0].clone(), |acc, e| fuse(&acc, &maps[e.child], &to_root[e.child], params.fusion))
     });
     let report = MultiReport {
         algorithm: merger.name().to_string(),

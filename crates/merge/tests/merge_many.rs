@@ -15,9 +15,13 @@ fn window(map: &OccupancyGrid, x0: f64, x1: f64, y0: f64, y1: f64) -> OccupancyG
     let o = map.origin();
     assert_eq!(o.rotation.angle(), 0.0, "floor plans are axis-aligned");
     let r = map.resolution();
-    let mut g =
-        OccupancyGrid::new(i1 - i0, j1 - j0, r, pose(o.translation.x + i0 as f64 * r, o.translation.y + j0 as f64 * r, 0.0))
-            .unwrap();
+    let mut g = OccupancyGrid::new(
+        i1 - i0,
+        j1 - j0,
+        r,
+        pose(o.translation.x + i0 as f64 * r, o.translation.y + j0 as f64 * r, 0.0),
+    )
+    .unwrap();
     for j in j0..j1 {
         for i in i0..i1 {
             g.set(i - i0, j - j0, map.get(i, j));
@@ -46,13 +50,8 @@ fn overlapping_cuts_are_placed_and_a_stranger_is_left_out() {
         window(&other, 0.2, 0.8, 0.2, 0.8),
     ];
     // Each map re-rendered in its own frame: t_k_world takes the building's frame into map k's.
-    let moves = [
-        pose(0.7, -1.2, 0.4),
-        pose(-2.0, 3.0, -1.9),
-        pose(4.0, 1.0, 2.6),
-        pose(-3.5, -2.5, 0.9),
-        pose(1.0, 1.0, -0.6),
-    ];
+    let moves =
+        [pose(0.7, -1.2, 0.4), pose(-2.0, 3.0, -1.9), pose(4.0, 1.0, 2.6), pose(-3.5, -2.5, 0.9), pose(1.0, 1.0, -0.6)];
     let maps: Vec<OccupancyGrid> = cuts.iter().zip(&moves).map(|(c, t)| resample(c, t, p.resolution)).collect();
     let out = merge_many(&SiftMerger::default(), &maps, &MergeParams::default());
     let r = &out.report;
