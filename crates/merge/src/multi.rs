@@ -294,8 +294,8 @@ mod tests {
         assert_eq!(r.not_connected, vec![3]);
         assert!(!r.all_connected());
         assert_eq!(r.tree.len(), 2);
-        for i in 0..3 {
-            assert!(close(&r.transforms[i].unwrap().to_pose(), &poses[i]), "map {i}: {:?}", r.transforms[i]);
+        for (i, (t, truth)) in r.transforms.iter().zip(&poses).take(3).enumerate() {
+            assert!(close(&t.unwrap().to_pose(), truth), "map {i}: {t:?}");
         }
         assert!(r.transforms[3].is_none());
         assert!(out.merged.is_some());
