@@ -15,7 +15,8 @@ Exit codes:
   1  failure or bad input: a file, a value or the command line itself (the message names the file, line
      and field, or the flag)
   2  `mrslam merge` only: the merge was refused (no reliable transform); no merged map is written. With three
-     or more maps: some map joins no other map's tree with the first; the maps that do join are merged";
+     or more maps: some map could not be placed in the first map's frame (no chain of accepted pairs joins
+     them); the maps that could are merged and written";
 
 /// Multi-robot SLAM and map merging testbed: simulate, map, merge, evaluate.
 #[derive(Parser)]

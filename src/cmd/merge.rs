@@ -25,7 +25,8 @@ pub struct MergeArgs {
     /// More maps: with three or more, every pair is merged and a spanning tree of the most confident accepted
     /// pairs places each map in the first map's frame; exit 2 when some map joins nothing.
     pub more: Vec<PathBuf>,
-    /// Merged map to write (YAML + PGM beside it); not written when the merge is rejected.
+    /// Merged map to write (YAML + PGM beside it); not written when the merge is rejected (with three or more
+    /// maps: when no map joins the first).
     #[arg(short, long)]
     pub output: Option<PathBuf>,
     /// Write the merge report (JSON) here, accepted or not.

@@ -31,12 +31,9 @@ pub fn run(args: &MergeArgs, mut maps: Vec<OccupancyGrid>, merger: &dyn Merger, 
     let files: Vec<&PathBuf> = [&args.a, &args.b].into_iter().chain(&args.more).collect();
     let out = merge_many(merger, &maps, mp);
     if let Some(p) = &args.report {
-        let mut json = serde_json::to_value(&out.report).context("serialising the report")?;
-        if let Some(obj) = json.as_object_mut() {
-            let names = files.iter().map(|f| serde_json::Value::from(f.display().to_string())).collect();
-            obj.insert("files".into(), serde_json::Value::Array(names));
-        }
-        let bytes = serde_json::to_vec_pretty(&json).context("serialising the report")?;
+        let files = files.iter().map(|f| f.display().to_string()).collect();
+        let bytes =
+            serde_json::to_vec_pretty(&Report { files, report: &out.report }).context("serialising the report")?;
         write_file_atomic(p, &bytes)?;
     }
     print!("{}", summary(&out.report, &files));
@@ -58,6 +55,16 @@ pub fn run(args: &MergeArgs, mut maps: Vec<OccupancyGrid>, merger: &dyn Merger, 
         _ => {}
     }
     Ok(if out.report.all_connected() { ExitCode::SUCCESS } else { ExitCode::from(2) })
+}
+
+/// The JSON `--report` writes: the map files in order, then the library's report.
+#[derive(serde::Serialize)]
+struct Report<'a> {
+    /// The maps as given, in order (indices in the report refer to them).
+    files: Vec<String>,
+    /// The N-map merge's report.
+    #[serde(flatten)]
+    report: &'a MultiReport,
 }
 
 /// A transform as the summary prints it.
