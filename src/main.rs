@@ -14,7 +14,9 @@ Exit codes:
   0  success
   1  failure or bad input: a file, a value or the command line itself (the message names the file, line
      and field, or the flag)
-  2  `mrslam merge` only: the merge was refused (no reliable transform); no merged map is written";
+  2  `mrslam merge` only: the merge was refused (no reliable transform); no merged map is written. With three
+     or more maps: some map could not be placed in the first map's frame (no chain of accepted pairs joins
+     them); the maps that could are merged and written";
 
 /// Multi-robot SLAM and map merging testbed: simulate, map, merge, evaluate.
 #[derive(Parser)]
@@ -31,7 +33,7 @@ enum Command {
     Map(cmd::map::MapCommand),
     /// Detect SIFT keypoints in an image or a map; print, save as JSON, draw.
     Features(cmd::features::FeaturesArgs),
-    /// Merge two maps of unknown relative pose (exit 2 when no reliable transform is found).
+    /// Merge two or more maps of unknown relative pose (exit 2 when a map cannot be placed).
     Merge(cmd::merge::MergeArgs),
     /// Inspect CARMEN laser logs.
     #[command(subcommand)]

@@ -1,4 +1,4 @@
-//! `mrslam merge A.yaml B.yaml -o MERGED.yaml`: merge two maps of unknown relative pose.
+//! `mrslam merge A.yaml B.yaml [C.yaml ...] -o MERGED.yaml`: merge two maps (or more) of unknown relative pose.
 
 use anyhow::{Context, Result, bail};
 use clap::Args;
@@ -22,7 +22,11 @@ pub struct MergeArgs {
     pub a: PathBuf,
     /// Second map (map_server YAML).
     pub b: PathBuf,
-    /// Merged map to write (YAML + PGM beside it); not written when the merge is rejected.
+    /// More maps: with three or more, every pair is merged and a spanning tree of the most confident accepted
+    /// pairs places each map in the first map's frame; exit 2 when some map joins nothing.
+    pub more: Vec<PathBuf>,
+    /// Merged map to write (YAML + PGM beside it); not written when the merge is rejected (with three or more
+    /// maps: when no map joins the first).
     #[arg(short, long)]
     pub output: Option<PathBuf>,
     /// Write the merge report (JSON) here, accepted or not.
@@ -97,7 +101,11 @@ pub fn run(args: MergeArgs) -> Result<ExitCode> {
         }
     }
     let outputs: Vec<&Path> = kinds.iter().filter_map(|(p, ..)| p.as_deref()).collect();
-    super::paths::check_outputs(&outputs, &[&args.a, &args.b])?;
+    let inputs: Vec<&Path> = [&args.a, &args.b].into_iter().chain(&args.more).map(PathBuf::as_path).collect();
+    super::paths::check_outputs(&outputs, &inputs)?;
+    if !args.more.is_empty() {
+        super::merge_many::refuse_pair_only_flags(&args)?;
+    }
     let a = super::map::read_yaml_map(&args.a)?;
     let b = super::map::read_yaml_map(&args.b)?;
     let (name_a, name_b) = pair_names(&args.a, &args.b);
@@ -126,6 +134,9 @@ pub fn run(args: MergeArgs) -> Result<ExitCode> {
         }
     };
     let mp = MergeParams { verify_enabled: !args.no_verify, fusion: args.fusion, ..MergeParams::default() };
+    if !args.more.is_empty() {
+        return super::merge_many::run(&args, vec![a, b], merger.as_ref(), &mp);
+    }
     let out = merge(merger.as_ref(), &a, &b, &mp);
     if let Some(p) = &args.report {
         let json = serde_json::to_vec_pretty(&out.report).context("serialising the report")?;

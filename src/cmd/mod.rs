@@ -5,6 +5,7 @@ pub mod features;
 pub mod log;
 pub mod map;
 pub mod merge;
+pub mod merge_many;
 pub mod paths;
 pub mod run;
 pub mod slam;

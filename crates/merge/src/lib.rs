@@ -3,6 +3,7 @@
 //! The paper's SIFT merger ([`SiftMerger`], Algorithm 3) and its R-map baseline ([`RmapMerger`], Algorithm 1)
 //! behind the [`Merger`] interface, named by [`Algorithm`], a verification
 //! gate that rejects merges the maps themselves contradict ([`verify`]), fusion into one grid ([`fuse`]),
+//! N maps at once along a spanning tree of the most confident pairs ([`multi`]),
 //! and the generators evaluation needs: procedural floor plans ([`floorplan`]) and map pairs cut with a
 //! known overlap and a known transform ([`pairs`]).
 
@@ -13,6 +14,7 @@ pub mod fuse;
 pub mod map_image;
 pub mod matching;
 pub mod merger;
+pub mod multi;
 pub mod pairs;
 pub mod refine;
 pub mod report;
@@ -27,6 +29,7 @@ pub use fuse::FusionRule;
 pub use map_image::MapEncoding;
 pub use matching::MatchParams;
 pub use merger::{Alignment, Evidence, MergeOutcome, MergeParams, Merger, NoAlignment, merge};
+pub use multi::{MultiOutcome, MultiReport, PairReport, TreeEdge, merge_many};
 pub use refine::RefineParams;
 pub use report::{MergeReport, TransformXyt};
 pub use rmap::{RmapMerger, RmapParams};

@@ -1,0 +1,319 @@
+//! Merging N maps at once: every pair through [`merge`], a maximum spanning tree of the accepted pairs by
+//! confidence (m-explore's approach), each map's transform into map 0's frame composed along the tree, and
+//! the maps joined to map 0 fused into one grid in its frame.
+
+use crate::fuse::fuse;
+use crate::merger::{MergeParams, Merger, merge};
+use crate::report::{MergeReport, TransformXyt};
+use mrslam_core::{OccupancyGrid, Pose2};
+use rayon::prelude::*;
+use std::time::Instant;
+
+/// One pair's merge: `report.transform` is `T_a_b` (points of map `b` into map `a`'s frame).
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct PairReport {
+    /// Index of the first map (the frame the transform maps into).
+    pub a: usize,
+    /// Index of the second map, `b > a`.
+    pub b: usize,
+    /// The two-map pipeline's report, accepted or not, with its reason.
+    pub report: MergeReport,
+}
+
+/// An edge of the spanning forest, oriented away from its component's root.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct TreeEdge {
+    /// The map nearer the root.
+    pub parent: usize,
+    /// The map this edge joins to the tree.
+    pub child: usize,
+    /// Index of the pair in [`MultiReport::pairs`] that gave the edge.
+    pub pair: usize,
+    /// The pair's confidence (the edge's weight).
+    pub confidence: f64,
+    /// `T_parent_child`: points of the child's frame into the parent's.
+    pub transform: TransformXyt,
+}
+
+/// What [`merge_many`] reports (also the JSON `mrslam merge` writes for three or more maps).
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct MultiReport {
+    /// Algorithm name.
+    pub algorithm: String,
+    /// Number of maps merged.
+    pub maps: usize,
+    /// Every pair (a < b) in order (0,1), (0,2), ..., (1,2), ...: accepted or not, with the reason.
+    pub pairs: Vec<PairReport>,
+    /// The spanning forest's edges: map 0's tree first (breadth first from map 0), then the other components'.
+    pub tree: Vec<TreeEdge>,
+    /// `T_0_i` for each map i joined to map 0 by the tree (map 0's own is the identity); None for the rest.
+    pub transforms: Vec<Option<TransformXyt>>,
+    /// Connected components of the accepted pairs, each sorted, map 0's first, the rest by smallest member.
+    pub components: Vec<Vec<usize>>,
+    /// Maps not joined to map 0, ascending (empty when every map is connected).
+    pub not_connected: Vec<usize>,
+    /// Wall time of all the pairwise merges, the tree and the fusion, milliseconds.
+    pub time_ms: f64,
+}
+
+impl MultiReport {
+    /// Whether every map is joined to map 0.
+    pub fn all_connected(&self) -> bool {
+        self.not_connected.is_empty()
+    }
+}
+
+/// Everything [`merge_many`] produced.
+#[derive(Debug, Clone)]
+pub struct MultiOutcome {
+    /// The report.
+    pub report: MultiReport,
+    /// The maps joined to map 0 fused in map 0's frame and resolution; None when no other map joins map 0
+    /// (nothing was merged) or there are no maps.
+    pub merged: Option<OccupancyGrid>,
+}
+
+/// Union-find over map indices, with path halving; the smaller index becomes the root.
+struct UnionFind(Vec<usize>);
+
+impl UnionFind {
+    fn new(n: usize) -> Self {
+        UnionFind((0..n).collect())
+    }
+    fn find(&mut self, mut i: usize) -> usize {
+        while self.0[i] != i {
+            self.0[i] = self.0[self.0[i]];
+            i = self.0[i];
+        }
+        i
+    }
+    /// Joins the sets of `i` and `j`; false when they were one already.
+    fn union(&mut self, i: usize, j: usize) -> bool {
+        let (ri, rj) = (self.find(i), self.find(j));
+        if ri == rj {
+            return false;
+        }
+        let (lo, hi) = (ri.min(rj), ri.max(rj));
+        self.0[hi] = lo;
+        true
+    }
+}
+
+/// An accepted pair as a weighted edge: (pair index, a, b, confidence, `T_a_b`).
+type Edge = (usize, usize, usize, f64, Pose2);
+
+/// Kruskal's maximum spanning forest: the most confident edges first, ties by pair index.
+fn spanning_forest(n: usize, edges: &[Edge]) -> Vec<Edge> {
+    let mut order: Vec<&Edge> = edges.iter().filter(|e| e.1 < n && e.2 < n).collect();
+    order.sort_by(|x, y| y.3.total_cmp(&x.3).then(x.0.cmp(&y.0)));
+    let mut uf = UnionFind::new(n);
+    order.into_iter().filter(|e| uf.union(e.1, e.2)).cloned().collect()
+}
+
+/// The forest's components (sorted, by smallest member) and its edges oriented breadth first from each
+/// component's smallest map, with `T_root_i` for every map.
+fn orient(n: usize, forest: &[Edge]) -> (Vec<Vec<usize>>, Vec<TreeEdge>, Vec<Pose2>) {
+    let mut adjacent: Vec<Vec<&Edge>> = vec![Vec::new(); n];
+    for e in forest {
+        adjacent[e.1].push(e);
+        adjacent[e.2].push(e);
+    }
+    let mut seen = vec![false; n];
+    let mut to_root = vec![Pose2::identity(); n];
+    let (mut components, mut tree) = (Vec::new(), Vec::new());
+    for root in 0..n {
+        if seen[root] {
+            continue;
+        }
+        seen[root] = true;
+        let mut queue = vec![root];
+        let mut k = 0;
+        while k < queue.len() {
+            let parent = queue[k];
+            k += 1;
+            for &&(pair, a, b, confidence, t_a_b) in &adjacent[parent] {
+                let (child, t_parent_child) = if a == parent { (b, t_a_b) } else { (a, t_a_b.inverse()) };
+                if seen[child] {
+                    continue;
+                }
+                seen[child] = true;
+                to_root[child] = to_root[parent] * t_parent_child;
+                tree.push(TreeEdge {
+                    parent,
+                    child,
+                    pair,
+                    confidence,
+                    transform: TransformXyt::from_pose(&t_parent_child),
+                });
+                queue.push(child);
+            }
+        }
+        queue.sort_unstable();
+        components.push(queue);
+    }
+    (components, tree, to_root)
+}
+
+/// Merges N maps: [`merge`] on every pair (in parallel, reported in pair order), a maximum spanning tree of
+/// the accepted pairs by confidence rooted at map 0, each map's transform into map 0's frame along the tree,
+/// and the maps joined to map 0 fused one by one (tree order) onto map 0 with `params.fusion`.
+///
+/// Maps of different resolution are handled as [`merge`] handles them; the fused grid has map 0's.
+pub fn merge_many(merger: &dyn Merger, maps: &[OccupancyGrid], params: &MergeParams) -> MultiOutcome {
+    let start = Instant::now();
+    let n = maps.len();
+    let index: Vec<(usize, usize)> = (0..n).flat_map(|a| (a + 1..n).map(move |b| (a, b))).collect();
+    let pairs: Vec<PairReport> = index
+        .par_iter()
+        .map(|&(a, b)| PairReport { a, b, report: merge(merger, &maps[a], &maps[b], params).report })
+        .collect();
+    let edges: Vec<Edge> = pairs
+        .iter()
+        .enumerate()
+        .filter(|(_, p)| p.report.accepted)
+        .filter_map(|(k, p)| Some((k, p.a, p.b, p.report.confidence, p.report.transform?.to_pose())))
+        .collect();
+    let forest = spanning_forest(n, &edges);
+    let (components, tree, to_root) = orient(n, &forest);
+    let joined: &[usize] = components.first().map_or(&[], |c| c.as_slice());
+    let transforms: Vec<Option<TransformXyt>> =
+        (0..n).map(|i| joined.contains(&i).then(|| TransformXyt::from_pose(&to_root[i]))).collect();
+    let not_connected: Vec<usize> = (0..n).filter(|i| !joined.contains(i)).collect();
+    // Fused in tree order (breadth first from map 0): each map lands next to maps already in.
+    let merged = (joined.len() > 1).then(|| {
+        tree.iter()
+            .filter(|e| joined.contains(&e.child))
+            .fold(maps[0].clone(), |acc, e| fuse(&acc, &maps[e.child], &to_root[e.child], params.fusion))
+    });
+    let report = MultiReport {
+        algorithm: merger.name().to_string(),
+        maps: n,
+        pairs,
+        tree,
+        transforms,
+        components,
+        not_connected,
+        time_ms: start.elapsed().as_secs_f64() * 1e3,
+    };
+    MultiOutcome { report, merged }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::merger::{Alignment, Evidence, NoAlignment};
+    use mrslam_core::pose;
+    use std::collections::BTreeMap;
+
+    fn close(p: &Pose2, q: &Pose2) -> bool {
+        let d = p.inverse() * q;
+        d.translation.vector.norm() < 1e-9 && d.rotation.angle().abs() < 1e-9
+    }
+
+    #[test]
+    fn the_forest_takes_the_most_confident_edges() {
+        let t = Pose2::identity();
+        // A triangle 0-1-2 and a weak 2-3: the weakest triangle edge (0-2) closes a cycle and is dropped.
+        let edges = vec![(0, 0, 1, 0.9, t), (1, 0, 2, 0.2, t), (3, 1, 2, 0.5, t), (5, 2, 3, 0.1, t)];
+        let kept: Vec<usize> = spanning_forest(4, &edges).iter().map(|e| e.0).collect();
+        assert_eq!(kept, vec![0, 3, 5]);
+        // Equal confidence: the lower pair index wins.
+        let tie = vec![(4, 1, 2, 0.5, t), (0, 0, 1, 0.5, t), (2, 0, 2, 0.5, t)];
+        let kept: Vec<usize> = spanning_forest(3, &tie).iter().map(|e| e.0).collect();
+        assert_eq!(kept, vec![0, 2]);
+    }
+
+    #[test]
+    fn transforms_compose_along_the_tree_whichever_way_edges_point() {
+        let t01 = pose(1.0, 2.0, 0.3);
+        let t21 = pose(-0.5, 1.5, -1.1); // the pair (1, 2) gives T_1_2; store it that way
+        let t12 = t21.inverse();
+        let t13 = pose(3.0, -1.0, 2.0);
+        let forest = vec![(0, 0, 1, 0.9, t01), (3, 1, 2, 0.8, t12), (4, 1, 3, 0.7, t13)];
+        let (components, tree, to_root) = orient(4, &forest);
+        assert_eq!(components, vec![vec![0, 1, 2, 3]]);
+        assert!(close(&to_root[1], &t01));
+        assert!(close(&to_root[2], &(t01 * t12)));
+        assert!(close(&to_root[3], &(t01 * t13)));
+        // A chain stored against the tree's direction: the pair (0, 1) rooted at 1 still gives T_0_1.
+        let (_, tree2, to_root2) = orient(3, &[(1, 1, 2, 0.5, t12), (0, 0, 2, 0.4, t21.inverse() * t01)]);
+        assert_eq!((tree2[0].parent, tree2[0].child), (0, 2));
+        assert!(close(&to_root2[2], &(t21.inverse() * t01)));
+        assert!(close(&to_root2[1], &(t21.inverse() * t01 * t12.inverse())));
+        assert_eq!(tree.iter().map(|e| (e.parent, e.child)).collect::<Vec<_>>(), vec![(0, 1), (1, 2), (1, 3)]);
+    }
+
+    /// Answers with known transforms between "maps" told apart by their width: width 10 + k is map k, placed
+    /// at `poses[k]` in a common world; pairs listed in `refuse` get no transform.
+    struct Known {
+        poses: Vec<Pose2>,
+        refuse: Vec<(usize, usize)>,
+    }
+
+    impl Merger for Known {
+        fn name(&self) -> &'static str {
+            "known"
+        }
+        fn align(&self, a: &OccupancyGrid, b: &OccupancyGrid) -> Result<Alignment, Box<NoAlignment>> {
+            let (i, j) = (a.width() - 10, b.width() - 10);
+            if self.refuse.contains(&(i, j)) || self.refuse.contains(&(j, i)) {
+                return Err(Box::new(NoAlignment {
+                    reason: "nothing in common".into(),
+                    matches: 0,
+                    timings_ms: BTreeMap::new(),
+                    evidence: Evidence::default(),
+                }));
+            }
+            Ok(Alignment {
+                transform: self.poses[i].inverse() * self.poses[j],
+                scale: 1.0,
+                matches: 40,
+                matched_features: 40,
+                inliers: 30 + i + j,
+                timings_ms: BTreeMap::new(),
+                evidence: Evidence::default(),
+                alternatives: Vec::new(),
+            })
+        }
+    }
+
+    #[test]
+    fn a_map_joined_to_nothing_is_reported_and_the_rest_placed() {
+        let poses = vec![pose(0.0, 0.0, 0.0), pose(2.0, 1.0, 0.5), pose(-1.0, 3.0, -2.0), pose(0.0, 0.0, 0.0)];
+        let refuse = vec![(0, 3), (1, 3), (2, 3)];
+        let maps: Vec<OccupancyGrid> =
+            (0..4).map(|k| OccupancyGrid::new(10 + k, 10, 0.1, pose(0.0, 0.0, 0.0)).unwrap()).collect();
+        let mut p = MergeParams { verify_enabled: false, ..MergeParams::default() };
+        p.refine.enabled = false;
+        let out = merge_many(&Known { poses: poses.clone(), refuse }, &maps, &p);
+        let r = &out.report;
+        assert_eq!(r.pairs.len(), 6);
+        assert_eq!(r.pairs.iter().map(|p| (p.a, p.b)).collect::<Vec<_>>()[..3], [(0, 1), (0, 2), (0, 3)]);
+        assert!(!r.pairs[2].report.accepted && r.pairs[2].report.reason.as_deref() == Some("nothing in common"));
+        assert_eq!(r.components, vec![vec![0, 1, 2], vec![3]]);
+        assert_eq!(r.not_connected, vec![3]);
+        assert!(!r.all_connected());
+        assert_eq!(r.tree.len(), 2);
+        for (i, (t, truth)) in r.transforms.iter().zip(&poses).take(3).enumerate() {
+            assert!(close(&t.unwrap().to_pose(), truth), "map {i}: {t:?}");
+        }
+        assert!(r.transforms[3].is_none());
+        assert!(out.merged.is_some());
+        // Two maps that join each other but not map 0 form their own component.
+        let out = merge_many(&Known { poses, refuse: vec![(0, 2), (0, 3), (1, 2), (1, 3)] }, &maps, &p);
+        assert_eq!(out.report.components, vec![vec![0, 1], vec![2, 3]]);
+        assert_eq!(out.report.not_connected, vec![2, 3]);
+        assert_eq!(out.report.tree.iter().map(|e| (e.parent, e.child)).collect::<Vec<_>>(), vec![(0, 1), (2, 3)]);
+    }
+
+    #[test]
+    fn no_maps_and_one_map_give_nothing_merged() {
+        let known = Known { poses: vec![Pose2::identity()], refuse: Vec::new() };
+        let out = merge_many(&known, &[], &MergeParams::default());
+        assert!(out.merged.is_none() && out.report.components.is_empty() && out.report.pairs.is_empty());
+        let one = [OccupancyGrid::new(10, 10, 0.1, pose(0.0, 0.0, 0.0)).unwrap()];
+        let out = merge_many(&known, &one, &MergeParams::default());
+        assert!(out.merged.is_none() && out.report.all_connected());
+        assert_eq!(out.report.transforms, vec![Some(TransformXyt::from_pose(&Pose2::identity()))]);
+    }
+}

@@ -1,0 +1,118 @@
+//! `mrslam merge A.yaml B.yaml C.yaml ...`: three or more maps merged along a spanning tree of the most
+//! confident accepted pairs, each placed in the first map's frame.
+
+use super::merge::MergeArgs;
+use anyhow::{Context, Result, bail};
+use mrslam_core::OccupancyGrid;
+use mrslam_core::map_io::{self, write_file_atomic};
+use mrslam_merge::{MergeParams, Merger, MultiReport, TransformXyt, merge_many};
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+/// Fails on the flags that only make sense for two maps (the match drawing, the rerun recording).
+pub fn refuse_pair_only_flags(args: &MergeArgs) -> Result<()> {
+    let n = 2 + args.more.len();
+    if args.matches_png.is_some() {
+        bail!("--matches-png draws the matches of two maps, and {n} maps were given; merge a pair to draw it");
+    }
+    if !args.viz.targets()?.is_empty() {
+        bail!(
+            "--rrd, --spawn and --connect record the merge of two maps, and {n} maps were given; merge a pair to record it"
+        );
+    }
+    Ok(())
+}
+
+/// Runs the N-map merge: `maps` holds the first two maps, read already; the rest are read from `args.more`.
+pub fn run(args: &MergeArgs, mut maps: Vec<OccupancyGrid>, merger: &dyn Merger, mp: &MergeParams) -> Result<ExitCode> {
+    for p in &args.more {
+        maps.push(super::map::read_yaml_map(p)?);
+    }
+    let files: Vec<&PathBuf> = [&args.a, &args.b].into_iter().chain(&args.more).collect();
+    let out = merge_many(merger, &maps, mp);
+    if let Some(p) = &args.report {
+        let files = files.iter().map(|f| f.display().to_string()).collect();
+        let bytes =
+            serde_json::to_vec_pretty(&Report { files, report: &out.report }).context("serialising the report")?;
+        write_file_atomic(p, &bytes)?;
+    }
+    print!("{}", summary(&out.report, &files));
+    match (&out.merged, &args.output) {
+        (Some(g), Some(path)) => {
+            map_io::write_ros_map(g, path)?;
+            let joined = out.report.maps - out.report.not_connected.len();
+            println!(
+                "merged map: {} ({}x{} cells, {joined} of {} maps)",
+                path.display(),
+                g.width(),
+                g.height(),
+                out.report.maps
+            );
+        }
+        (None, Some(path)) => {
+            println!("merged map: not written to {} (no map joins {})", path.display(), files[0].display())
+        }
+        _ => {}
+    }
+    Ok(if out.report.all_connected() { ExitCode::SUCCESS } else { ExitCode::from(2) })
+}
+
+/// The JSON `--report` writes: the map files in order, then the library's report.
+#[derive(serde::Serialize)]
+struct Report<'a> {
+    /// The maps as given, in order (indices in the report refer to them).
+    files: Vec<String>,
+    /// The N-map merge's report.
+    #[serde(flatten)]
+    report: &'a MultiReport,
+}
+
+/// A transform as the summary prints it.
+fn xyt(t: &TransformXyt) -> String {
+    format!("x {:.3} m, y {:.3} m, theta {:.4} rad ({:.2} deg)", t.x, t.y, t.theta, t.theta.to_degrees())
+}
+
+/// The human summary of an N-map merge: a line per pair, the tree, each map's transform, the maps left out.
+pub fn summary(r: &MultiReport, files: &[&PathBuf]) -> String {
+    let name = |i: usize| files.get(i).map_or_else(|| format!("map {i}"), |f| short(f));
+    let joined = r.maps - r.not_connected.len();
+    let mut s =
+        format!("merge of {} maps ({}): {joined} of {} in the frame of {}\n", r.maps, r.algorithm, r.maps, name(0));
+    s += "pairs (transform takes the second map into the first's frame):\n";
+    for q in &r.pairs {
+        let m = &q.report;
+        s += &format!("  {} + {}: ", name(q.a), name(q.b));
+        if m.accepted {
+            let t = m.transform.as_ref().map_or_else(|| "-".to_string(), xyt);
+            s += &format!("ACCEPTED  confidence {:.2}, {} inliers; {t}\n", m.confidence, m.inliers);
+        } else {
+            s += &format!("REJECTED  {}\n", m.reason.as_deref().unwrap_or("no reason given"));
+        }
+    }
+    s += "tree (most confident accepted pairs, Kruskal):\n";
+    if r.tree.is_empty() {
+        s += "  no accepted pair\n";
+    }
+    for e in &r.tree {
+        s += &format!("  {} -> {} (confidence {:.2})\n", name(e.parent), name(e.child), e.confidence);
+    }
+    s += &format!("transforms into the frame of {}:\n", name(0));
+    for (i, t) in r.transforms.iter().enumerate() {
+        s += &format!("  {}: {}\n", name(i), t.as_ref().map_or_else(|| "not connected".to_string(), xyt));
+    }
+    for c in r.components.iter().skip(1) {
+        let names: Vec<String> = c.iter().map(|&i| name(i)).collect();
+        if c.len() == 1 {
+            s += &format!("left out:   {} joins no other map\n", names.join(""));
+        } else {
+            s += &format!("left out:   {} join each other but not {}\n", names.join(", "), name(0));
+        }
+    }
+    s += &format!("time:       {:.1} ms\n", r.time_ms);
+    s
+}
+
+/// A map's file name for the summary (the whole path when it has none).
+fn short(p: &Path) -> String {
+    p.file_name().map_or_else(|| p.display().to_string(), |n| n.to_string_lossy().into_owned())
+}
