@@ -26,9 +26,38 @@ fn set(p: &mut CorrelativeParams, kv: &str) {
         "keep" => p.keep_ratio = f,
         "hyp" => p.hypotheses = f as usize,
         "fang" => p.fine_angles = f as usize,
+        "acc" => p.min_acceptance = f,
+        "area" => p.min_overlap_m2 = f,
         "par" => p.parallel = f != 0.0,
         _ => panic!("unknown key {k}"),
     }
+}
+
+/// Share of b's walls over a's known cells with a wall of a within `k` cells (square), for k = 1..=4.
+fn tolerant_walls(a: &OccupancyGrid, b: &OccupancyGrid, t: &Pose2) -> Vec<f64> {
+    use mrslam_core::CellState;
+    let walls = mrslam_merge::refine::wall_points(b);
+    (1..=4i64)
+        .map(|k| {
+            let (mut n, mut hit) = (0usize, 0usize);
+            for p in &walls {
+                let (ix, iy) = a.world_to_cell_i(&(t * p));
+                let Some(l) = a.get_checked(ix, iy) else { continue };
+                if CellState::from_log_odds(l) == CellState::Unknown {
+                    continue;
+                }
+                n += 1;
+                let near = (-k..=k).any(|dy| {
+                    (-k..=k).any(|dx| {
+                        a.get_checked(ix + dx, iy + dy)
+                            .is_some_and(|l| CellState::from_log_odds(l) == CellState::Occupied)
+                    })
+                });
+                hit += usize::from(near);
+            }
+            hit as f64 / n.max(1) as f64
+        })
+        .collect()
 }
 
 fn error(t: &Pose2, truth: &Pose2) -> (f64, f64) {
@@ -37,7 +66,8 @@ fn error(t: &Pose2, truth: &Pose2) -> (f64, f64) {
 }
 
 fn run(m: &dyn Merger, a: &OccupancyGrid, b: &OccupancyGrid, truth: Option<&Pose2>) -> (bool, Option<(f64, f64)>, f64) {
-    let out = merge(m, a, b, &MergeParams::default());
+    let verify = std::env::var("NOVERIFY").is_err();
+    let out = merge(m, a, b, &MergeParams { verify_enabled: verify, ..MergeParams::default() });
     let r = &out.report;
     let t = r.transform.map(|t| pose(t.x, t.y, t.theta));
     let err = t.as_ref().zip(truth).map(|(t, tr)| error(t, tr));
@@ -57,6 +87,9 @@ fn run(m: &dyn Merger, a: &OccupancyGrid, b: &OccupancyGrid, truth: Option<&Pose
         r.time_ms,
         r.timings_ms.iter().map(|(k, v)| format!("{k} {v:.0}")).collect::<Vec<_>>()
     );
+    if let Some(t) = &t {
+        println!("  wall agreement at 1..4 cells: {:?}", tolerant_walls(a, b, t));
+    }
     (r.accepted, err, r.time_ms)
 }
 
@@ -110,6 +143,7 @@ fn main() {
         let refined = mrslam_merge::refine::refine(&a, &walls, t, &mrslam_merge::RefineParams::default());
         for (name, t) in [("truth", *t), ("truth+icp", refined)] {
             let agr = mrslam_merge::verify::agreement(&a, &b, &t);
+            println!("  wall agreement at 1..4 cells: {:?}", tolerant_walls(&a, &b, &t));
             println!(
                 "{name}: {:?} omega {:.3} walls {:.3} ({} of {}) common {}",
                 (t.translation.x, t.translation.y, t.rotation.angle()),

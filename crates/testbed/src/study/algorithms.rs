@@ -1,10 +1,10 @@
 //! The merge algorithms a study compares, built for one trial.
 
-use mrslam_merge::{Algorithm, Merger, RmapMerger, RmapParams, SiftMerger, SiftMergerParams};
+use mrslam_merge::{Algorithm, CorrelativeMerger, Merger, RmapMerger, RmapParams, SiftMerger, SiftMergerParams};
 
 /// `algorithm`'s merger with default parameters for a map-level trial seeded `seed`.
 ///
-/// Only the SIFT merger's draws (its RANSAC) follow `seed`; the R-map merger's orientation draws keep their
+/// The correlative merger has no random draws. Only the SIFT merger's draws (its RANSAC) follow `seed`; the R-map merger's orientation draws keep their
 /// default seed ([`RmapParams::default`], 0) in every trial, as the published studies were computed. A
 /// simulated run ([`crate::runner::merger_for`]) seeds both with the scenario's seed.
 pub fn study_merger(algorithm: Algorithm, seed: u64) -> Box<dyn Merger> {
@@ -15,6 +15,7 @@ pub fn study_merger(algorithm: Algorithm, seed: u64) -> Box<dyn Merger> {
             Box::new(SiftMerger::new(p))
         }
         Algorithm::Rmap => Box::new(RmapMerger::new(RmapParams::default())),
+        Algorithm::Correlative => Box::new(CorrelativeMerger::default()),
     }
 }
 
@@ -52,7 +53,7 @@ mod tests {
     fn names_are_read_and_checked() {
         assert_eq!(parse_algorithms(&["sift", "rmap"]).unwrap(), [Algorithm::Sift, Algorithm::Rmap]);
         let err = |names: &[&str]| parse_algorithms(names).unwrap_err().to_string();
-        assert_eq!(err(&["sift", "magic"]), "unknown algorithm `magic` (expected one of sift, rmap)");
+        assert_eq!(err(&["sift", "magic"]), "unknown algorithm `magic` (expected one of sift, rmap, correlative)");
         assert_eq!(err(&["rmap", "rmap"]), "algorithm `rmap` given twice");
         assert_eq!(err(&[]), "no algorithms given");
     }
