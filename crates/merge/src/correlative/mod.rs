@@ -28,7 +28,7 @@ pub mod scan;
 pub mod search;
 
 use crate::merger::{Alignment, Evidence, Hypothesis, Merger, NoAlignment};
-use crate::refine::wall_points;
+use crate::refine::{RefineParams, refine, wall_points};
 use crate::verify::{agreement, wall_hits};
 use field::{BlockStates, HIT, ScoreField};
 use local::{LocalWindow, ScanPose, local_search};
@@ -190,7 +190,7 @@ impl CorrelativeMerger {
         let t = Instant::now();
         let penalty = (p.free_penalty.max(0.0) * f64::from(HIT)).round() as i16;
         let field = ScoreField::build(&blocks, p.sigma_cells, penalty);
-        if !field.values.iter().any(|&v| v == HIT) {
+        if !field.values.contains(&HIT) {
             return Err(fail("map a has no walls".into(), timings.clone()));
         }
         let pyramid = Pyramid::build(&field, p.depth);
@@ -307,24 +307,31 @@ impl Merger for CorrelativeMerger {
         // A pose found by trying every pose needs a shared area of some size to count: a small patch where
         // the walls coincide by chance (a building corner on another) is expected somewhere.
         let t = Instant::now();
-        let cell_m2 = a.resolution() * a.resolution();
-        let checks: Vec<(f64, f64)> = refined
+        // Checked after the wall ICP the pipeline also runs (its second pass then starts converged): a pose a
+        // cell off lays thin walls on free space, which the acceptance index would count against it.
+        let icp = RefineParams::default();
+        let poses: Vec<Pose2> = refined
             .iter()
-            .map(|(_, q, _)| {
-                let agr = agreement(a, b, &to_transform(a, &scan.centroid, q));
+            .map(|(_, q, _)| refine(a, &fine_points, &to_transform(a, &scan.centroid, q), &icp))
+            .collect();
+        let cell_m2 = a.resolution() * a.resolution();
+        let checks: Vec<(f64, f64)> = poses
+            .iter()
+            .map(|t| {
+                let agr = agreement(a, b, t);
                 (agr.common() as f64 * cell_m2, agr.acceptance_index())
             })
             .collect();
         let largest = checks.iter().map(|c| c.0).fold(0.0, f64::max);
         let best_acceptance = checks.iter().map(|c| c.1).fold(0.0, f64::max);
-        let refined: Vec<(usize, ScanPose, i64)> = refined
+        let poses: Vec<Pose2> = poses
             .into_iter()
             .zip(&checks)
             .filter(|(_, (m2, acc))| *m2 >= p.min_overlap_m2 && *acc >= p.min_acceptance)
-            .map(|(r, _)| r)
+            .map(|(t, _)| t)
             .collect();
         timings.insert("overlap".into(), ms(t));
-        if refined.is_empty() {
+        if poses.is_empty() {
             return Err(fail(
                 format!(
                     "no pose both shares {:.1} m² of known space and has an acceptance index of {:.2}: the best \
@@ -336,10 +343,9 @@ impl Merger for CorrelativeMerger {
         }
         let t = Instant::now();
         let points_b: Vec<Point2<f64>> = scan.points.iter().map(|v| scan.centroid + v).collect();
-        let hypotheses: Vec<Hypothesis> = refined
+        let hypotheses: Vec<Hypothesis> = poses
             .iter()
-            .map(|(_, q, _)| {
-                let transform = to_transform(a, &scan.centroid, q);
+            .map(|&transform| {
                 let (_, inliers) = wall_hits(a, &points_b, &transform);
                 Hypothesis { transform, scale: 1.0, inliers, inlier_pairs: Vec::new() }
             })
