@@ -10,6 +10,7 @@
 //!     branch and bound over all translations           search::branch_and_bound
 //! best distinct (rotation, translation) overall        hypotheses, strongest first
 //! each: exhaustive window at a's resolution            local::local_search
+//! each: wall ICP, then least shared area and acceptance  refine::refine, verify::agreement
 //! ```
 //!
 //! The shared pipeline then refines each answer by wall ICP and puts it through the verification gate.
@@ -66,7 +67,9 @@ pub struct CorrelativeParams {
     pub per_rotation: usize,
     /// Lowest global score, as a share of every point of b on a wall of a.
     pub min_score: f64,
-    /// Answers scoring below this share of the best one are dropped; rotations searched later prune with it.
+    /// Answers scoring below this share of the best one are dropped; rotations searched later prune with it
+    /// (0.7 halves the search time against 0.5 with the same answers on the measured pairs; a rival the gate
+    /// must see fits about as well as the best, 0.9 of its walls).
     pub keep_ratio: f64,
     /// Hypotheses handed to verification: the best and this many minus one alternatives.
     pub hypotheses: usize,
@@ -108,7 +111,7 @@ impl Default for CorrelativeParams {
             max_fine_points: 6000,
             per_rotation: 2,
             min_score: 0.03,
-            keep_ratio: 0.5,
+            keep_ratio: 0.7,
             hypotheses: 4,
             distinct_m: 1.0,
             fine_angles: 3,
