@@ -60,6 +60,32 @@ fn tolerant_walls(a: &OccupancyGrid, b: &OccupancyGrid, t: &Pose2) -> Vec<f64> {
         .collect()
 }
 
+/// b's walls in 20 m tiles (b's frame): per tile with 200+ walls over a's known cells, the wall agreement at
+/// `t` and after ICP of that tile alone, as (walls, at t, after tile ICP, tile ICP shift m, rotation deg).
+fn tiles(a: &OccupancyGrid, b: &OccupancyGrid, t: &Pose2) {
+    let walls = mrslam_merge::refine::wall_points(b);
+    let mut by_tile: std::collections::BTreeMap<(i64, i64), Vec<nalgebra::Point2<f64>>> = Default::default();
+    for p in &walls {
+        by_tile.entry(((p.x / 20.0).floor() as i64, (p.y / 20.0).floor() as i64)).or_default().push(*p);
+    }
+    for (k, pts) in by_tile {
+        let (n, m) = mrslam_merge::verify::wall_hits(a, &pts, t);
+        if n < 200 {
+            continue;
+        }
+        let local = mrslam_merge::refine::refine(a, &pts, t, &mrslam_merge::RefineParams::default());
+        let (_, m2) = mrslam_merge::verify::wall_hits(a, &pts, &local);
+        let d = t.inverse() * local;
+        println!(
+            "  tile {k:?}: {n} walls, agreement {:.2} -> {:.2} after its own ICP (moved {:.2} m, {:.2} deg)",
+            m as f64 / n as f64,
+            m2 as f64 / n as f64,
+            d.translation.vector.norm(),
+            d.rotation.angle().to_degrees()
+        );
+    }
+}
+
 fn error(t: &Pose2, truth: &Pose2) -> (f64, f64) {
     let d = truth.inverse() * t;
     (d.translation.vector.norm(), d.rotation.angle().to_degrees().abs())
@@ -89,6 +115,9 @@ fn run(m: &dyn Merger, a: &OccupancyGrid, b: &OccupancyGrid, truth: Option<&Pose
     );
     if let Some(t) = &t {
         println!("  wall agreement at 1..4 cells: {:?}", tolerant_walls(a, b, t));
+        if std::env::var("TILES").is_ok() {
+            tiles(a, b, t);
+        }
     }
     (r.accepted, err, r.time_ms)
 }
