@@ -71,3 +71,20 @@ fn maps_at_different_resolutions_are_merged() {
     let (deg, m) = error(t.x, t.y, t.theta, &pair.t_a_b);
     assert!(deg < 1.0 && m < 0.15, "off by {deg:.2} deg, {m:.3} m; {:?}", out.report.reason);
 }
+
+#[test]
+fn answers_do_not_depend_on_threads() {
+    use mrslam_merge::CorrelativeParams;
+    let map = generate(6, &plan());
+    let pair = cut_pair(&map, &PairSpec { overlap: 0.3, max_shift_m: 4.0, rotate: true }, 6);
+    let parallel = CorrelativeMerger::default();
+    let single = CorrelativeMerger::new(CorrelativeParams { parallel: false, ..CorrelativeParams::default() });
+    let first = parallel.align(&pair.a, &pair.b).expect("an answer");
+    for m in [&parallel, &single] {
+        let again = m.align(&pair.a, &pair.b).expect("an answer");
+        assert_eq!(again.transform, first.transform);
+        let alts = |al: &mrslam_merge::Alignment| al.alternatives.iter().map(|h| h.transform).collect::<Vec<_>>();
+        assert_eq!(alts(&again), alts(&first));
+        assert_eq!((again.inliers, again.matches), (first.inliers, first.matches));
+    }
+}
