@@ -14,6 +14,8 @@ fn set(p: &mut CorrelativeParams, kv: &str) {
     let f: f64 = v.parse().expect("number");
     match k {
         "res" => p.search_resolution = f,
+        "screen" => p.screen_resolution = f,
+        "cands" => p.screen_candidates = f as usize,
         "sigma" => p.sigma_cells = f,
         "fsigma" => p.fine_sigma_cells = f,
         "pen" => p.free_penalty = f,

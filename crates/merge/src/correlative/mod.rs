@@ -48,6 +48,14 @@ use std::time::Instant;
 pub struct CorrelativeParams {
     /// Cell size of the global search, metres: both maps are pooled to it (never finer than a map's own).
     pub search_resolution: f64,
+    /// Cell size of a first screening of every rotation and translation, metres; its best
+    /// [`CorrelativeParams::screen_candidates`] are searched again around themselves at `search_resolution`.
+    /// Below 1.5 `search_resolution` (the default, 0), no screening: the whole search runs at
+    /// `search_resolution`. Measured at 0.8 m with 64 candidates: 4x faster on the real pairs (both still
+    /// found), but 12 instead of 22 of 24 generated pairs merged, so off.
+    pub screen_resolution: f64,
+    /// Distinct answers of the screening searched again.
+    pub screen_candidates: usize,
     /// Blur (Gaussian σ) of a's walls in the global search, search cells.
     pub sigma_cells: f64,
     /// Blur of a's walls in the fine stage, cells of a.
@@ -102,6 +110,8 @@ impl Default for CorrelativeParams {
     fn default() -> Self {
         CorrelativeParams {
             search_resolution: 0.4,
+            screen_resolution: 0.0,
+            screen_candidates: 64,
             sigma_cells: 0.5,
             fine_sigma_cells: 1.5,
             free_penalty: 2.0,
@@ -163,6 +173,13 @@ fn to_transform(a: &OccupancyGrid, c: &Point2<f64>, p: &ScanPose) -> Pose2 {
     *a.origin() * pose(p.tx - rc.x, p.ty - rc.y, p.theta)
 }
 
+/// The scan pose of `T_a_b` for a scan about centroid `c`: its rotation, and where `c` lands in a's grid frame.
+fn to_scan_pose(a: &OccupancyGrid, c: &Point2<f64>, t_a_b: &Pose2) -> ScanPose {
+    let t_g_b = a.origin().inverse() * t_a_b;
+    let q = t_g_b * c;
+    ScanPose { theta: t_g_b.rotation.angle(), tx: q.x, ty: q.y }
+}
+
 /// Fills in a failure.
 fn fail(reason: String, timings: BTreeMap<String, f64>) -> Box<NoAlignment> {
     Box::new(NoAlignment { reason, matches: 0, timings_ms: timings, evidence: Evidence::default() })
@@ -174,12 +191,14 @@ impl CorrelativeMerger {
         &self,
         a: &OccupancyGrid,
         b: &OccupancyGrid,
+        resolution: f64,
+        keep: usize,
         timings: &mut BTreeMap<String, f64>,
-    ) -> Result<(Vec<ScanPose>, f64), Box<NoAlignment>> {
+    ) -> Result<(Vec<Pose2>, f64), Box<NoAlignment>> {
         let p = &self.params;
         let t = Instant::now();
-        let fa = ((p.search_resolution / a.resolution()).round() as usize).max(1);
-        let fb = ((p.search_resolution / b.resolution()).round() as usize).max(1);
+        let fa = ((resolution / a.resolution()).round() as usize).max(1);
+        let fb = ((resolution / b.resolution()).round() as usize).max(1);
         let cell = fa as f64 * a.resolution();
         let blocks = BlockStates::of(a, fa);
         let scan = WallScan::of_blocks(b, fb, p.max_points);
@@ -256,7 +275,7 @@ impl CorrelativeMerger {
                 .all(|k| (q.tx - k.tx).hypot(q.ty - k.ty) + scan.radius * angle_gap(q.theta, k.theta) > p.distinct_m);
             if distinct {
                 kept.push(q);
-                if kept.len() >= p.hypotheses.max(1) {
+                if kept.len() >= keep.max(1) {
                     break;
                 }
             }
@@ -267,7 +286,58 @@ impl CorrelativeMerger {
                 timings.clone(),
             ));
         }
-        Ok((kept, step))
+        Ok((kept.iter().map(|q| to_transform(a, &scan.centroid, q)).collect(), step))
+    }
+
+    /// The global answers at [`CorrelativeParams::search_resolution`], strongest first, and the angular step
+    /// they were found at; screened first at [`CorrelativeParams::screen_resolution`] when that is coarser.
+    fn search(
+        &self,
+        a: &OccupancyGrid,
+        b: &OccupancyGrid,
+        timings: &mut BTreeMap<String, f64>,
+    ) -> Result<(Vec<Pose2>, f64), Box<NoAlignment>> {
+        let p = &self.params;
+        if p.screen_resolution < 1.5 * p.search_resolution {
+            return self.global(a, b, p.search_resolution, p.hypotheses, timings);
+        }
+        let (coarse, coarse_step) = self.global(a, b, p.screen_resolution, p.screen_candidates, timings)?;
+        // Each screened answer searched again around itself at the search resolution.
+        let t = Instant::now();
+        let fa = ((p.search_resolution / a.resolution()).round() as usize).max(1);
+        let fb = ((p.search_resolution / b.resolution()).round() as usize).max(1);
+        let cell = fa as f64 * a.resolution();
+        let scan = WallScan::of_blocks(b, fb, p.max_points);
+        let penalty = (p.free_penalty.max(0.0) * f64::from(HIT)).round() as i16;
+        let field = Pyramid::build(&ScoreField::build(&BlockStates::of(a, fa), p.sigma_cells, penalty), 0);
+        let step = (p.angle_step_scale * cell / scan.radius.max(cell)).min(PI / 2.0);
+        let window = LocalWindow {
+            cells: (p.screen_resolution / cell).ceil() as i32 + 1,
+            angles: (coarse_step / step).ceil() as usize,
+            angle_step: step,
+        };
+        let mut buf = Vec::new();
+        let mut found: Vec<(usize, ScanPose, i64)> = coarse
+            .iter()
+            .enumerate()
+            .map(|(i, t_a_b)| {
+                let start = to_scan_pose(a, &scan.centroid, t_a_b);
+                let (q, s) = local_search(&field.levels[0], cell, &scan, start, &window, &mut buf);
+                (i, q, s)
+            })
+            .collect();
+        found.sort_by(|x, y| y.2.cmp(&x.2).then(x.0.cmp(&y.0)));
+        let mut kept: Vec<ScanPose> = Vec::new();
+        for (_, q, _) in &found {
+            let distinct = kept
+                .iter()
+                .all(|k| (q.tx - k.tx).hypot(q.ty - k.ty) + scan.radius * angle_gap(q.theta, k.theta) > p.distinct_m);
+            if distinct && kept.len() < p.hypotheses.max(1) {
+                kept.push(*q);
+            }
+        }
+        timings.insert("search_local".into(), ms(t));
+        Ok((kept.iter().map(|q| to_transform(a, &scan.centroid, q)).collect(), step))
     }
 }
 
@@ -279,7 +349,7 @@ impl Merger for CorrelativeMerger {
     fn align(&self, a: &OccupancyGrid, b: &OccupancyGrid) -> Result<Alignment, Box<NoAlignment>> {
         let p = &self.params;
         let mut timings = BTreeMap::new();
-        let (global, step) = self.global(a, b, &mut timings)?;
+        let (global, step) = self.search(a, b, &mut timings)?;
         // Fine stage at a's resolution.
         let t = Instant::now();
         let fine_points = wall_points(b);
@@ -300,8 +370,9 @@ impl Merger for CorrelativeMerger {
         let mut refined: Vec<(usize, ScanPose, i64)> = global
             .iter()
             .enumerate()
-            .map(|(i, g)| {
-                let (q, s) = local_search(&fine.levels[0], a.resolution(), &scan, *g, &window, &mut buf);
+            .map(|(i, t_a_b)| {
+                let start = to_scan_pose(a, &scan.centroid, t_a_b);
+                let (q, s) = local_search(&fine.levels[0], a.resolution(), &scan, start, &window, &mut buf);
                 (i, q, s)
             })
             .collect();
