@@ -33,6 +33,9 @@ fn generated_cuts_are_merged_at_their_true_transform() {
     }
 }
 
+/// Seeds 10-15 of 18 m x 14 m plans. Known limit: over seeds 10-69 the gate let through 4 of 60 such gap pairs
+/// (seeds 24, 30, 35, 61: 21-43 m² laid wall on wall, acceptance 0.95-0.97) and 1 of 60 at 24 m x 18 m;
+/// trying every pose finds such coincidences in self-similar plans, SIFT's features do not (0 of 120).
 #[test]
 fn pairs_that_share_nothing_are_refused_never_merged() {
     let merger = CorrelativeMerger::default();
