@@ -7,8 +7,8 @@ use mrslam_core::OccupancyGrid;
 use mrslam_core::map_io::{self, write_file_atomic};
 use mrslam_merge::map_image::MapImage;
 use mrslam_merge::{
-    Algorithm, Evidence, FusionRule, MapEncoding, MatchParams, MergeParams, MergeReport, Merger, Model, RmapMerger,
-    RmapParams, SiftMerger, SiftMergerParams, merge,
+    Algorithm, CorrelativeMerger, Evidence, FusionRule, MapEncoding, MatchParams, MergeParams, MergeReport, Merger,
+    Model, RmapMerger, RmapParams, SiftMerger, SiftMergerParams, merge,
 };
 use mrslam_testbed::runner::merge_view;
 use mrslam_viz::pair::record_pair;
@@ -32,7 +32,8 @@ pub struct MergeArgs {
     /// Write the merge report (JSON) here, accepted or not.
     #[arg(long)]
     pub report: Option<PathBuf>,
-    /// Merge algorithm: `sift` (the paper's, Alg. 3) or `rmap` (Park's R-map baseline, Alg. 1).
+    /// Merge algorithm: `sift` (the paper's, Alg. 3), `rmap` (Park's R-map baseline, Alg. 1) or `correlative`
+    /// (global correlative search by branch and bound).
     #[arg(long, default_value = "sift", value_parser = algorithm_parser())]
     pub algorithm: Algorithm,
     /// Transform model: rigid, similarity or homography (the paper's; its rigid part is used).
@@ -132,6 +133,7 @@ pub fn run(args: MergeArgs) -> Result<ExitCode> {
             rp.orient.seed = args.seed;
             Box::new(RmapMerger::new(rp))
         }
+        Algorithm::Correlative => Box::new(CorrelativeMerger::default()),
     };
     let mp = MergeParams { verify_enabled: !args.no_verify, fusion: args.fusion, ..MergeParams::default() };
     if !args.more.is_empty() {

@@ -62,7 +62,7 @@ pub struct OverlapArgs {
     /// Trials per overlap.
     #[arg(long, default_value_t = 30)]
     pub trials: usize,
-    /// Algorithms, comma-separated (sift, rmap).
+    /// Algorithms, comma-separated (sift, rmap, correlative).
     #[arg(long, default_value = "sift,rmap", value_delimiter = ',')]
     pub algorithms: Vec<String>,
     /// Output folder: results.csv, summary.csv, plot.png.

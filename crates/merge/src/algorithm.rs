@@ -10,7 +10,7 @@ use std::str::FromStr;
 /// let a: Algorithm = "rmap".parse().unwrap();
 /// assert_eq!(a, Algorithm::Rmap);
 /// assert_eq!(a.to_string(), "rmap");
-/// assert!("magic".parse::<Algorithm>().unwrap_err().to_string().contains("sift, rmap"));
+/// assert!("magic".parse::<Algorithm>().unwrap_err().to_string().contains("sift, rmap, correlative"));
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum Algorithm {
@@ -18,22 +18,25 @@ pub enum Algorithm {
     Sift,
     /// `rmap`: Park's R-map baseline (Algorithm 1), [`crate::RmapMerger`].
     Rmap,
+    /// `correlative`: global correlative search by branch and bound, [`crate::CorrelativeMerger`].
+    Correlative,
 }
 
 impl Algorithm {
     /// Every algorithm, in the order they are listed and compared.
-    pub const ALL: [Algorithm; 2] = [Algorithm::Sift, Algorithm::Rmap];
+    pub const ALL: [Algorithm; 3] = [Algorithm::Sift, Algorithm::Rmap, Algorithm::Correlative];
 
-    /// The name (`sift`, `rmap`): what [`FromStr`] reads, [`Display`](fmt::Display) writes and
+    /// The name (`sift`, `rmap`, `correlative`): what [`FromStr`] reads, [`Display`](fmt::Display) writes and
     /// [`crate::Merger::name`] returns.
     pub const fn name(self) -> &'static str {
         match self {
             Algorithm::Sift => "sift",
             Algorithm::Rmap => "rmap",
+            Algorithm::Correlative => "correlative",
         }
     }
 
-    /// The names of [`Algorithm::ALL`], comma-separated: `sift, rmap`.
+    /// The names of [`Algorithm::ALL`], comma-separated: `sift, rmap, correlative`.
     pub fn names() -> String {
         Algorithm::ALL.map(Algorithm::name).join(", ")
     }
@@ -72,10 +75,10 @@ mod tests {
         for a in Algorithm::ALL {
             assert_eq!(a.to_string().parse::<Algorithm>(), Ok(a));
         }
-        assert_eq!(Algorithm::names(), "sift, rmap");
+        assert_eq!(Algorithm::names(), "sift, rmap, correlative");
         assert_eq!(
             "SIFT".parse::<Algorithm>().unwrap_err().to_string(),
-            "unknown algorithm `SIFT` (expected one of sift, rmap)"
+            "unknown algorithm `SIFT` (expected one of sift, rmap, correlative)"
         );
     }
 }

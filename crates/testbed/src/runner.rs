@@ -7,8 +7,8 @@ use crate::scenario::{ControllerKind, MergeWhen, RobotSetup, Scenario};
 use mrslam_core::map_io::{self, MapIoError};
 use mrslam_core::{CellTraversal, LaserScan, OccupancyGrid, Odometry, Pose2};
 use mrslam_merge::{
-    Algorithm, MatchParams, MergeOutcome, MergeParams, Merger, RmapMerger, RmapParams, SiftMerger, SiftMergerParams,
-    TransformXyt, merge,
+    Algorithm, CorrelativeMerger, MatchParams, MergeOutcome, MergeParams, Merger, RmapMerger, RmapParams, SiftMerger,
+    SiftMergerParams, TransformXyt, merge,
 };
 use mrslam_sim::geometry::Obstacle;
 use mrslam_sim::{RobotId, Sim, SimConfig, SimError, StepEvents};
@@ -86,6 +86,7 @@ pub fn merger_for(algorithm: Algorithm, scenario: &Scenario) -> Box<dyn Merger> 
             p.orient.seed = scenario.seed;
             Box::new(RmapMerger::new(p))
         }
+        Algorithm::Correlative => Box::new(CorrelativeMerger::default()),
     }
 }
 

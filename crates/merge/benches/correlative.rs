@@ -1,0 +1,40 @@
+//! The correlative merger on the 600×600 pair of the SIFT benchmark (`merge.rs`): the whole `merge` pipeline
+//! with the rotation search on rayon's threads and on one thread, and the global search alone.
+#![allow(missing_docs, reason = "criterion_group! defines an undocumented public function")]
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use mrslam_merge::floorplan::{FloorplanParams, generate};
+use mrslam_merge::pairs::{PairSpec, cut_pair};
+use mrslam_merge::{CorrelativeMerger, CorrelativeParams, MergeParams, Merger, merge};
+use std::hint::black_box;
+
+fn bench_correlative(c: &mut Criterion) {
+    // A 29 m × 29 m building at 5 cm with a 0.5 m margin: a 600 × 600 map, cut in two at overlap 0.5.
+    let plan = FloorplanParams { width_m: 29.0, height_m: 29.0, ..FloorplanParams::default() };
+    let map = generate(7, &plan);
+    assert_eq!((map.width(), map.height()), (600, 600));
+    let pair = cut_pair(&map, &PairSpec { overlap: 0.5, max_shift_m: 2.0, rotate: true }, 7);
+    let params = MergeParams::default();
+    let parallel = CorrelativeMerger::default();
+    let single = CorrelativeMerger::new(CorrelativeParams { parallel: false, ..CorrelativeParams::default() });
+    let out = merge(&parallel, &pair.a, &pair.b, &params);
+    eprintln!(
+        "correlative: accepted {} {:?}, stages (ms): {:?}",
+        out.report.accepted, out.report.reason, out.report.timings_ms
+    );
+    assert!(out.report.accepted, "the benchmark pair must merge: {:?}", out.report.reason);
+    let mut g = c.benchmark_group("correlative_600x600");
+    g.bench_function("merge", |b| b.iter(|| merge(&parallel, black_box(&pair.a), black_box(&pair.b), &params)));
+    g.bench_function("merge_one_thread", |b| {
+        b.iter(|| merge(&single, black_box(&pair.a), black_box(&pair.b), &params))
+    });
+    g.bench_function("align_one_thread", |b| b.iter(|| single.align(black_box(&pair.a), black_box(&pair.b))));
+    g.finish();
+}
+
+criterion_group! {
+    name = benches;
+    config = Criterion::default().sample_size(10);
+    targets = bench_correlative
+}
+criterion_main!(benches);

@@ -1,0 +1,190 @@
+//! Runs the correlative merger on two map files (optionally against a known `T_a_b`) or on generated pairs,
+//! with parameter overrides, and prints each answer:
+//! `cargo run --release -p mrslam-merge --example correlative_probe -- A.yaml B.yaml [x y theta] [key=value ...]`
+//! `cargo run --release -p mrslam-merge --example correlative_probe -- gen [key=value ...]`.
+
+use mrslam_core::map_io::read_ros_map;
+use mrslam_core::{OccupancyGrid, Pose2, pose};
+use mrslam_merge::floorplan::{FloorplanParams, generate};
+use mrslam_merge::pairs::{PairSpec, cut_pair};
+use mrslam_merge::{CorrelativeMerger, CorrelativeParams, MergeParams, Merger, SiftMerger, merge};
+
+fn set(p: &mut CorrelativeParams, kv: &str) {
+    let (k, v) = kv.split_once('=').expect("key=value");
+    let f: f64 = v.parse().expect("number");
+    match k {
+        "res" => p.search_resolution = f,
+        "screen" => p.screen_resolution = f,
+        "cands" => p.screen_candidates = f as usize,
+        "sigma" => p.sigma_cells = f,
+        "fsigma" => p.fine_sigma_cells = f,
+        "pen" => p.free_penalty = f,
+        "depth" => p.depth = f as usize,
+        "astep" => p.angle_step_scale = f,
+        "pts" => p.max_points = f as usize,
+        "fpts" => p.max_fine_points = f as usize,
+        "per" => p.per_rotation = f as usize,
+        "min" => p.min_score = f,
+        "keep" => p.keep_ratio = f,
+        "hyp" => p.hypotheses = f as usize,
+        "fang" => p.fine_angles = f as usize,
+        "acc" => p.min_acceptance = f,
+        "area" => p.min_overlap_m2 = f,
+        "par" => p.parallel = f != 0.0,
+        _ => panic!("unknown key {k}"),
+    }
+}
+
+/// Share of b's walls over a's known cells with a wall of a within `k` cells (square), for k = 1..=4.
+fn tolerant_walls(a: &OccupancyGrid, b: &OccupancyGrid, t: &Pose2) -> Vec<f64> {
+    use mrslam_core::CellState;
+    let walls = mrslam_merge::refine::wall_points(b);
+    (1..=4i64)
+        .map(|k| {
+            let (mut n, mut hit) = (0usize, 0usize);
+            for p in &walls {
+                let (ix, iy) = a.world_to_cell_i(&(t * p));
+                let Some(l) = a.get_checked(ix, iy) else { continue };
+                if CellState::from_log_odds(l) == CellState::Unknown {
+                    continue;
+                }
+                n += 1;
+                let near = (-k..=k).any(|dy| {
+                    (-k..=k).any(|dx| {
+                        a.get_checked(ix + dx, iy + dy)
+                            .is_some_and(|l| CellState::from_log_odds(l) == CellState::Occupied)
+                    })
+                });
+                hit += usize::from(near);
+            }
+            hit as f64 / n.max(1) as f64
+        })
+        .collect()
+}
+
+/// b's walls in 20 m tiles (b's frame): per tile with 200+ walls over a's known cells, the wall agreement at
+/// `t` and after ICP of that tile alone, as (walls, at t, after tile ICP, tile ICP shift m, rotation deg).
+fn tiles(a: &OccupancyGrid, b: &OccupancyGrid, t: &Pose2) {
+    let walls = mrslam_merge::refine::wall_points(b);
+    let mut by_tile: std::collections::BTreeMap<(i64, i64), Vec<nalgebra::Point2<f64>>> = Default::default();
+    for p in &walls {
+        by_tile.entry(((p.x / 20.0).floor() as i64, (p.y / 20.0).floor() as i64)).or_default().push(*p);
+    }
+    for (k, pts) in by_tile {
+        let (n, m) = mrslam_merge::verify::wall_hits(a, &pts, t);
+        if n < 200 {
+            continue;
+        }
+        let local = mrslam_merge::refine::refine(a, &pts, t, &mrslam_merge::RefineParams::default());
+        let (_, m2) = mrslam_merge::verify::wall_hits(a, &pts, &local);
+        let d = t.inverse() * local;
+        println!(
+            "  tile {k:?}: {n} walls, agreement {:.2} -> {:.2} after its own ICP (moved {:.2} m, {:.2} deg)",
+            m as f64 / n as f64,
+            m2 as f64 / n as f64,
+            d.translation.vector.norm(),
+            d.rotation.angle().to_degrees()
+        );
+    }
+}
+
+fn error(t: &Pose2, truth: &Pose2) -> (f64, f64) {
+    let d = truth.inverse() * t;
+    (d.translation.vector.norm(), d.rotation.angle().to_degrees().abs())
+}
+
+fn run(m: &dyn Merger, a: &OccupancyGrid, b: &OccupancyGrid, truth: Option<&Pose2>) -> (bool, Option<(f64, f64)>, f64) {
+    let verify = std::env::var("NOVERIFY").is_err();
+    let out = merge(m, a, b, &MergeParams { verify_enabled: verify, ..MergeParams::default() });
+    let r = &out.report;
+    let t = r.transform.map(|t| pose(t.x, t.y, t.theta));
+    let err = t.as_ref().zip(truth).map(|(t, tr)| error(t, tr));
+    println!(
+        "{}: accepted {} t {:?} err {:?} inl {}/{} conf {:.2} omega {:?} walls {:?} amb {:?} reason {:?} time {:.0} ms {:?}",
+        m.name(),
+        r.accepted,
+        r.transform.map(|t| (t.x, t.y, t.theta)),
+        err,
+        r.inliers,
+        r.matches,
+        r.confidence,
+        r.acceptance_index,
+        r.wall_agreement,
+        r.ambiguity,
+        r.reason,
+        r.time_ms,
+        r.timings_ms.iter().map(|(k, v)| format!("{k} {v:.0}")).collect::<Vec<_>>()
+    );
+    if let Some(t) = &t {
+        println!("  wall agreement at 1..4 cells: {:?}", tolerant_walls(a, b, t));
+        if std::env::var("TILES").is_ok() {
+            tiles(a, b, t);
+        }
+    }
+    (r.accepted, err, r.time_ms)
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let mut p = CorrelativeParams::default();
+    if args.first().is_some_and(|s| s == "gen") {
+        for kv in &args[1..] {
+            set(&mut p, kv);
+        }
+        let cor = CorrelativeMerger::new(p);
+        let sift = SiftMerger::default();
+        let mut stats = [[0usize; 3]; 2]; // per algorithm: ok, false, refused
+        for seed in 0..8u64 {
+            let map = generate(seed, &FloorplanParams { width_m: 29.0, height_m: 29.0, ..FloorplanParams::default() });
+            for overlap in [-0.1, 0.1, 0.3, 0.5] {
+                let pair = cut_pair(&map, &PairSpec { overlap, max_shift_m: 5.0, rotate: true }, seed);
+                println!("seed {seed} overlap {overlap} truth {:?}", pair.t_a_b);
+                for (k, m) in [&sift as &dyn Merger, &cor].into_iter().enumerate() {
+                    let (acc, err, _) = run(m, &pair.a, &pair.b, Some(&pair.t_a_b));
+                    let good = err.is_some_and(|(d, a)| d < 0.3 && a < 2.0) && overlap > 0.0;
+                    stats[k][if !acc {
+                        2
+                    } else if good {
+                        0
+                    } else {
+                        1
+                    }] += 1;
+                }
+            }
+        }
+        println!("sift ok/false/refused {:?}, correlative {:?}", stats[0], stats[1]);
+        return;
+    }
+    let a = read_ros_map(args[0].as_ref()).expect("map a");
+    let b = read_ros_map(args[1].as_ref()).expect("map b");
+    let mut rest = &args[2..];
+    let truth = if rest.len() >= 3 && !rest[0].contains('=') {
+        let v: Vec<f64> = rest[..3].iter().map(|s| s.parse().expect("number")).collect();
+        rest = &rest[3..];
+        Some(pose(v[0], v[1], v[2]))
+    } else {
+        None
+    };
+    for kv in rest {
+        set(&mut p, kv);
+    }
+    println!("a {}x{} b {}x{}", a.width(), a.height(), b.width(), b.height());
+    if let Some(t) = &truth {
+        let walls = mrslam_merge::refine::wall_points(&b);
+        let refined = mrslam_merge::refine::refine(&a, &walls, t, &mrslam_merge::RefineParams::default());
+        for (name, t) in [("truth", *t), ("truth+icp", refined)] {
+            let agr = mrslam_merge::verify::agreement(&a, &b, &t);
+            println!("  wall agreement at 1..4 cells: {:?}", tolerant_walls(&a, &b, &t));
+            println!(
+                "{name}: {:?} omega {:.3} walls {:.3} ({} of {}) common {}",
+                (t.translation.x, t.translation.y, t.rotation.angle()),
+                agr.acceptance_index(),
+                agr.wall_agreement(),
+                agr.walls_matched,
+                agr.walls,
+                agr.common()
+            );
+        }
+    }
+    run(&CorrelativeMerger::new(p), &a, &b, truth.as_ref());
+}
