@@ -95,15 +95,19 @@ pub fn run(args: RunArgs) -> Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-/// Removes the `.rrd` recordings an earlier run left in `dir`, keeping this run's (`keep`): a folder's
-/// recording always shows the run whose report and maps sit beside it.
+/// Removes the `.rrd` recordings an earlier run left in `dir`, keeping this run's (`keep`, and the partial file
+/// it is being written to): a folder's recording always shows the run whose report and maps sit beside it.
 fn remove_stale_recordings(dir: &Path, keep: Option<&Path>) -> Result<()> {
-    let keep = keep.and_then(|k| k.canonicalize().ok());
+    let kept: Vec<PathBuf> = keep
+        .into_iter()
+        .flat_map(|k| [k.to_path_buf(), mrslam_viz::target::partial_path(k)])
+        .filter_map(|k| k.canonicalize().ok())
+        .collect();
     let entries = std::fs::read_dir(dir).map_err(|e| anyhow::anyhow!("{}: {e}", dir.display()))?;
     for entry in entries.flatten() {
         let path = entry.path();
         let is_rrd = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("rrd")) && path.is_file();
-        if is_rrd && path.canonicalize().ok() != keep {
+        if is_rrd && !path.canonicalize().is_ok_and(|p| kept.contains(&p)) {
             std::fs::remove_file(&path)
                 .map_err(|e| anyhow::anyhow!("{}: cannot remove a stale recording: {e}", path.display()))?;
             println!("removed:  {} (the recording of an earlier run)", path.display());

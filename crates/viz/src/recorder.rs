@@ -17,6 +17,7 @@ use rerun::{
     ApplicationId, AsComponents, EntityPath, SerializedComponentBatch, StoreId, StoreKind, TimeCell, TimePoint,
 };
 use std::collections::BTreeMap;
+use std::path::PathBuf;
 use std::time::Duration;
 
 /// The application id of every mrslam recording (the viewer groups recordings and blueprints by it).
@@ -72,6 +73,8 @@ pub struct Recorder {
     pending_bytes: usize,
     stats: RecordingStats,
     error: Option<VizError>,
+    /// Files being written under a partial name, and their names once finished.
+    renames: Vec<(PathBuf, PathBuf)>,
 }
 
 impl std::fmt::Debug for Recorder {
@@ -93,8 +96,12 @@ impl Recorder {
     /// Fails before anything is recorded when a target cannot be opened.
     pub fn open(targets: &[Target], recording_id: &str, name: &str) -> Result<Recorder, VizError> {
         let mut sinks = Vec::with_capacity(targets.len());
+        let mut renames = Vec::new();
         for t in targets {
             sinks.push((t.describe(), t.open()?));
+            if let Target::File(path) = t {
+                renames.push((crate::target::partial_path(path), path.clone()));
+            }
         }
         let store = StoreId::new(StoreKind::Recording, ApplicationId::from(APP_ID), recording_id);
         let mut rec = Recorder {
@@ -108,6 +115,7 @@ impl Recorder {
             pending_bytes: 0,
             stats: RecordingStats::default(),
             error: None,
+            renames,
         };
         let info = SetStoreInfo { row_id: *rec.ids.row(), info: store_info(store) };
         rec.send(LogMsg::SetStoreInfo(info));
@@ -214,8 +222,16 @@ impl Recorder {
             }
         }
         let stats = self.stats;
-        let error = self.error.take();
+        let mut error = self.error.take();
         self.sinks.clear(); // dropping a file sink writes the footer and closes the file
+        if error.is_none() {
+            for (partial, path) in std::mem::take(&mut self.renames) {
+                if let Err(e) = std::fs::rename(&partial, &path) {
+                    error = Some(VizError::CreateFile { path, cause: format!("renaming {}: {e}", partial.display()) });
+                    break;
+                }
+            }
+        }
         match error {
             Some(e) => Err(e),
             None => Ok(stats),
@@ -259,7 +275,8 @@ impl Recorder {
 
 impl Drop for Recorder {
     fn drop(&mut self) {
-        // A run that stopped early still leaves a readable recording of what happened up to there.
+        // A run that stopped early still leaves a readable recording of what happened up to there, under its
+        // partial name (see `Target::File`).
         self.flush();
     }
 }
@@ -271,6 +288,21 @@ fn store_info(store: StoreId) -> StoreInfo {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_recording_gets_its_name_only_when_finished() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("run.rrd");
+        let partial = dir.path().join("run.partial.rrd");
+        let rec = Recorder::open(&[Target::File(path.clone())], "test", "test").unwrap();
+        drop(rec); // interrupted
+        assert!(!path.exists(), "an interrupted recording must not look complete");
+        assert!(partial.metadata().unwrap().len() > 0, "the partial recording is kept");
+        let rec = Recorder::open(&[Target::File(path.clone())], "test", "test").unwrap();
+        rec.finish().unwrap();
+        assert!(path.metadata().unwrap().len() > 0);
+        assert!(!partial.exists());
+    }
 
     #[test]
     fn ids_are_unique_and_increasing() {

@@ -13,7 +13,8 @@ pub const DEFAULT_CONNECT: &str = "127.0.0.1:9876";
 /// One destination of a recording.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum Target {
-    /// An `.rrd` file, written as the run goes and closed at the end.
+    /// An `.rrd` file, written as the run goes under [`partial_path`] and renamed to its name when the recording
+    /// finishes, so that an interrupted run leaves nothing that looks complete.
     File(PathBuf),
     /// A rerun viewer started now from PATH (`rerun`), streamed to over gRPC.
     Spawn,
@@ -46,7 +47,7 @@ impl Target {
     /// Opens the destination: creates the file, starts the viewer or dials the address.
     pub(crate) fn open(&self) -> Result<Box<dyn LogSink>, VizError> {
         match self {
-            Target::File(path) => open_file(path),
+            Target::File(path) => open_file(path, &partial_path(path)),
             Target::Spawn => {
                 if find_on_path("rerun").is_none() {
                     return Err(VizError::NoViewer);
@@ -85,7 +86,14 @@ fn probe(url: &str) -> Result<(), VizError> {
     })
 }
 
-fn open_file(path: &Path) -> Result<Box<dyn LogSink>, VizError> {
+/// Where the recording for `path` is written until it finishes: `NAME.partial.rrd` beside it (an interrupted run's
+/// recording stays there, readable by the viewer up to where the run stopped).
+pub fn partial_path(path: &Path) -> PathBuf {
+    let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+    path.with_file_name(format!("{stem}.partial.rrd"))
+}
+
+fn open_file(path: &Path, partial: &Path) -> Result<Box<dyn LogSink>, VizError> {
     let err = |cause: String| VizError::CreateFile { path: path.to_path_buf(), cause };
     if path.is_dir() {
         return Err(err("it is a folder".into()));
@@ -100,7 +108,7 @@ fn open_file(path: &Path) -> Result<Box<dyn LogSink>, VizError> {
     // stores), which would make two runs' files differ; the footer only speeds up random access to big files,
     // and `rerun rrd optimize` can add one.
     let options = FileSinkOptions { write_footer: false };
-    let sink = FileSink::with_options(path, options).map_err(|e| match e {
+    let sink = FileSink::with_options(partial, options).map_err(|e| match e {
         rerun::sink::FileSinkError::CreateFile { source, .. } => err(source.to_string()),
         other => err(other.to_string()),
     })?;
