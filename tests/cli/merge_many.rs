@@ -1,24 +1,11 @@
 //! `mrslam merge` with three or more maps, run as a user would.
-#![allow(clippy::unwrap_used, reason = "test code: a failed unwrap fails the test")]
 
+use crate::util::{mrslam, p, text};
 use mrslam_core::map_io::{read_ros_map, write_ros_map};
 use mrslam_core::{OccupancyGrid, Pose2, pose};
 use mrslam_merge::floorplan::{FloorplanParams, generate};
 use mrslam_merge::resample::resample;
 use std::path::Path;
-use std::process::{Command, Output};
-
-fn mrslam(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_mrslam")).args(args).output().expect("mrslam runs")
-}
-
-fn text(b: &[u8]) -> String {
-    String::from_utf8_lossy(b).into_owned()
-}
-
-fn p(path: &Path) -> &str {
-    path.to_str().unwrap()
-}
 
 /// The cells of `map` in the window [x0, x1) x [y0, y1) (fractions of its size), re-rendered at `res` in the
 /// frame `t_new_world` takes the building's frame to.

@@ -1,22 +1,8 @@
 //! `mrslam merge` and `mrslam map cut`, run as a user would.
-#![allow(clippy::unwrap_used, reason = "test code: a failed unwrap fails the test")]
 
+use crate::util::{mrslam, p, text};
 use mrslam_core::map_io::{read_ros_map, write_ros_map};
 use mrslam_merge::floorplan::{FloorplanParams, generate};
-use std::path::Path;
-use std::process::{Command, Output};
-
-fn mrslam(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_mrslam")).args(args).output().expect("mrslam runs")
-}
-
-fn text(b: &[u8]) -> String {
-    String::from_utf8_lossy(b).into_owned()
-}
-
-fn p(path: &Path) -> &str {
-    path.to_str().unwrap()
-}
 
 #[test]
 fn cut_then_merge_recovers_the_printed_transform() {

@@ -1,14 +1,8 @@
 //! `mrslam eval relations` run as a user would: a trajectory with a known error per relation gives exactly
 //! that error; unmatched stamps are counted as missing; bad files are refused naming file, line and field.
 
-#![allow(clippy::unwrap_used, reason = "test code: a failed unwrap fails the test")]
-
+use crate::util::mrslam;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn mrslam(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_mrslam")).args(args).output().expect("mrslam runs")
-}
 
 fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
     let p = dir.join(name);

@@ -1,21 +1,13 @@
 //! `mrslam study logs`, as a user would: a small synthetic CARMEN log with its relations, split into two
 //! robots, mapped, merged and scored; a resume; and bad input refused with exit code 1.
-#![allow(clippy::unwrap_used, reason = "test code: a failed unwrap fails the test")]
 
+use crate::util::{mrslam, text};
 use mrslam_core::Pose2;
 use mrslam_core::pose::pose_xyt;
 use mrslam_slam::synthetic::{self, Drift, Lidar, SyntheticRun};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn mrslam(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_mrslam")).args(args).output().expect("mrslam runs")
-}
-
-fn text(bytes: &[u8]) -> String {
-    String::from_utf8_lossy(bytes).into_owned()
-}
+use std::process::Output;
 
 /// The first 18 m of the synthetic office loop's first corridor, Hokuyo scans, slightly drifting odometry.
 fn run() -> SyntheticRun {

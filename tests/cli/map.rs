@@ -1,12 +1,8 @@
 //! The `map` and `log` commands, run as a user would: good input, and every kind of bad input.
-#![allow(clippy::unwrap_used, reason = "test code: a failed unwrap fails the test")]
 
+use crate::util::mrslam;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn mrslam(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_mrslam")).args(args).output().expect("mrslam runs")
-}
+use std::process::Output;
 
 fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()

@@ -1,22 +1,12 @@
 //! `mrslam slam` run as a user would: a CARMEN log of a drifting robot in, a map and a trajectory out that
 //! beat the odometry against the truth; bad logs and bad parameters refused, naming the line or the parameter.
 
-#![allow(clippy::unwrap_used, reason = "test code: a failed unwrap fails the test")]
-
+use crate::util::{mrslam, text};
 use mrslam_core::Pose2;
 use mrslam_core::pose::{pose_xyt, relative};
 use mrslam_slam::synthetic::{self, Drift, Lidar, SyntheticRun};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn mrslam(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_mrslam")).args(args).output().expect("mrslam runs")
-}
-
-fn text(bytes: &[u8]) -> String {
-    String::from_utf8_lossy(bytes).into_owned()
-}
 
 /// The first 12 m of the synthetic office loop, Hokuyo scans, odometry drifting 3 % and 0.01 rad/m.
 fn office_run() -> SyntheticRun {

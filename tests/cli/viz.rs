@@ -1,25 +1,13 @@
 //! `mrslam run ... --rrd` and `mrslam merge ... --rrd`, as a user would: the recording is read back with rerun's
 //! own decoder (through `mrslam_viz::inspect`), and must hold the designed entity paths and timelines with
 //! plausible counts, identical bytes on a second run, and bad destinations must fail before any work.
-#![allow(clippy::unwrap_used, reason = "test code: a failed unwrap fails the test")]
 
+use crate::util::{mrslam, p, text};
 use mrslam_core::map_io::write_ros_map;
 use mrslam_merge::floorplan::{FloorplanParams, generate};
 use mrslam_viz::inspect::summarize;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
-
-fn mrslam(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_mrslam")).args(args).output().expect("mrslam runs")
-}
-
-fn text(b: &[u8]) -> String {
-    String::from_utf8_lossy(b).into_owned()
-}
-
-fn p(path: &Path) -> &str {
-    path.to_str().unwrap()
-}
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))

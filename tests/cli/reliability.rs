@@ -1,24 +1,12 @@
 //! Careless input, as a new user types it: outputs named like inputs, typo'd flags, odd output names,
 //! maps with nothing in them. Nothing is overwritten, every error exits 1 and names what is wrong, and exit
 //! code 2 means only a refused merge.
-#![allow(clippy::unwrap_used, reason = "test code: a failed unwrap fails the test")]
 
+use crate::util::{mrslam, p, text};
 use mrslam_core::map_io::write_ros_map;
 use mrslam_merge::floorplan::{FloorplanParams, generate};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn mrslam(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_mrslam")).args(args).output().expect("mrslam runs")
-}
-
-fn text(b: &[u8]) -> String {
-    String::from_utf8_lossy(b).into_owned()
-}
-
-fn p(path: &Path) -> &str {
-    path.to_str().unwrap()
-}
+use std::process::Output;
 
 /// Runs `args`, expects exit 1 and a message with every needle, and no panic.
 fn fails_with(args: &[&str], needles: &[&str]) -> Output {

@@ -1,0 +1,16 @@
+//! End-to-end tests of the `mrslam` command line, one module per command, run as a user would run it.
+
+#![allow(clippy::unwrap_used, reason = "test code: a failed unwrap fails the test")]
+
+mod eval;
+mod features;
+mod map;
+mod merge;
+mod merge_many;
+mod reliability;
+mod run;
+mod slam;
+mod study;
+mod study_logs;
+mod util;
+mod viz;
