@@ -570,4 +570,12 @@ mod tests {
         s.merge.host = b.clone();
         assert_eq!(merge_pair(&s).unwrap(), (b, a));
     }
+
+    #[test]
+    fn every_algorithm_gets_its_own_merger() {
+        let s = two_rooms();
+        for a in Algorithm::ALL {
+            assert_eq!(merger_for(a, &s).name(), a.name());
+        }
+    }
 }

@@ -684,4 +684,52 @@ mod tests {
         let shown = e.to_string();
         assert!(shown.contains(&format!("paper_two_rooms.toml:{line}: robots[1].start: ")), "{shown}");
     }
+
+    #[test]
+    fn a_robots_slam_table_picks_a_preset_sets_parameters_by_name_and_the_lidar_caps_the_range() {
+        // Without a table: the preset that matches the lidar's reach (Hokuyo 4 m, RpLidar 6 m).
+        let s = two_rooms(|t| t).unwrap();
+        assert_eq!(s.robots[0].slam, {
+            let mut p = SlamParams::hokuyo();
+            p.max_range = p.max_range.min(s.robots[0].lidar.range_max);
+            p.max_urange = p.max_urange.min(s.robots[0].lidar.range_max);
+            p
+        });
+        assert!(!s.robots[1].slam.scan_odometry);
+        // A preset and parameters by name; the 80 m preset is capped at the robot's lidar.
+        let table =
+            "slam = { preset = \"matched\", particles = 12, scan_odometry_reach = 2, linear_update = \"0.4\" }\n";
+        let s = two_rooms(|t| {
+            let (head, second) = t.split_at(t.rfind("[[robots]]").unwrap());
+            format!("{head}{}", second.replacen("[[robots]]\n", &format!("[[robots]]\n{table}"), 1))
+        })
+        .unwrap();
+        let (slam, range) = (&s.robots[1].slam, s.robots[1].lidar.range_max);
+        assert!(slam.scan_odometry, "the matched preset");
+        assert_eq!((slam.particles, slam.scan_odometry_reach, slam.linear_update), (12, 2, 0.4));
+        assert!(
+            slam.max_range <= range && slam.max_urange <= range,
+            "{} {} > {range}",
+            slam.max_range,
+            slam.max_urange
+        );
+        // An unknown parameter or a bad value names the robot's table, the parameter and its line.
+        let refused = |table: &str| {
+            let mut text = String::new();
+            let e = two_rooms(|t| {
+                let (head, second) = t.split_at(t.rfind("[[robots]]").unwrap());
+                text = format!("{head}{}", second.replacen("[[robots]]\n", &format!("[[robots]]\n{table}\n"), 1));
+                text.clone()
+            })
+            .unwrap_err();
+            (e, line_holding(&text, table))
+        };
+        let (e, line) = refused("slam = { particels = 12 }");
+        assert_eq!((e.field.as_str(), e.line), ("robots[1].slam.particels", line), "{e}");
+        let (e, _) = refused("slam = { particles = [1, 2] }");
+        assert_eq!(e.field, "robots[1].slam.particles", "{e}");
+        assert!(e.message.contains("expected a number"), "{e}");
+        let (e, _) = refused("slam = { preset = \"fastslam\" }");
+        assert!(e.field.starts_with("robots[1].slam"), "{e}");
+    }
 }
