@@ -550,7 +550,7 @@ pub fn write_algorithm_summary(rows: &[AlgorithmSummary], path: &Path) -> Result
 /// The per-pair results and the summary as aligned text tables (what the CLI prints).
 pub fn pairs_table(rows: &[PairRow], summary: &[AlgorithmSummary]) -> String {
     let mut s = format!(
-        "{:<6} {:<6} {:>5} {:>7}  {:>17}  {:<8} {:>9} {:>9} {:>10}  {}\n",
+        "{:<6} {:<11} {:>5} {:>7}  {:>17}  {:<8} {:>9} {:>9} {:>10}  {}\n",
         "pair", "algo", "rels", "overlap", "truth floor m/deg", "result", "error m", "error deg", "time ms", "reason"
     );
     for r in rows {
@@ -563,7 +563,7 @@ pub fn pairs_table(rows: &[PairRow], summary: &[AlgorithmSummary]) -> String {
         };
         let _ = writeln!(
             s,
-            "{:<6} {:<6} {:>5} {:>7.3}  {:>8.3}/{:<8.2}  {:<8} {:>9} {:>9} {:>10.1}  {}",
+            "{:<6} {:<11} {:>5} {:>7.3}  {:>8.3}/{:<8.2}  {:<8} {:>9} {:>9} {:>10.1}  {}",
             format!("{}-{}", r.part_i, r.part_j),
             r.algorithm,
             r.relations,
@@ -579,13 +579,13 @@ pub fn pairs_table(rows: &[PairRow], summary: &[AlgorithmSummary]) -> String {
     }
     let _ = writeln!(
         s,
-        "\n{:<8} {:>5} {:>8} {:>9} {:>6} {:>11} {:>14}",
+        "\n{:<11} {:>5} {:>8} {:>9} {:>6} {:>11} {:>14}",
         "algo", "pairs", "accepted", "successes", "false", "median ms", "median err m"
     );
     for r in summary {
         let _ = writeln!(
             s,
-            "{:<8} {:>5} {:>8} {:>9} {:>6} {:>11.1} {:>14}",
+            "{:<11} {:>5} {:>8} {:>9} {:>6} {:>11.1} {:>14}",
             r.algorithm,
             r.pairs,
             r.accepted,
