@@ -3,6 +3,7 @@
 use crate::util::{mrslam, p, text};
 use mrslam_core::map_io::{read_ros_map, write_ros_map};
 use mrslam_merge::floorplan::{FloorplanParams, generate};
+use std::path::Path;
 
 #[test]
 fn cut_then_merge_recovers_the_printed_transform() {
@@ -50,21 +51,19 @@ fn cut_then_merge_recovers_the_printed_transform() {
     assert!(png.width() > 100 && png.height() > 100);
 }
 
+/// Generates floor plan `seed` as `d/plan.yaml` and cuts it into `d/a.yaml` and `d/b.yaml` at `overlap`.
+fn cut_plan(d: &Path, seed: u64, overlap: &str) {
+    write_ros_map(&generate(seed, &FloorplanParams::default()), &d.join("plan.yaml")).unwrap();
+    let (plan, a, b) = (d.join("plan.yaml"), d.join("a.yaml"), d.join("b.yaml"));
+    let o = mrslam(&["map", "cut", p(&plan), p(&a), p(&b), "--overlap", overlap]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+}
+
 #[test]
 fn rejected_merge_exits_2_and_writes_no_map() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    write_ros_map(&generate(22, &FloorplanParams::default()), &d.join("plan.yaml")).unwrap();
-    let o = mrslam(&[
-        "map",
-        "cut",
-        p(&d.join("plan.yaml")),
-        p(&d.join("a.yaml")),
-        p(&d.join("b.yaml")),
-        "--overlap",
-        "-0.2",
-    ]);
-    assert!(o.status.success(), "{}", text(&o.stderr));
+    cut_plan(d, 22, "-0.2");
     let o = mrslam(&[
         "merge",
         p(&d.join("a.yaml")),
@@ -142,17 +141,7 @@ fn outputs_that_cannot_be_written_fail_before_the_merge() {
 fn rmap_algorithm_writes_the_same_report() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    write_ros_map(&generate(25, &FloorplanParams::default()), &d.join("plan.yaml")).unwrap();
-    let o = mrslam(&[
-        "map",
-        "cut",
-        p(&d.join("plan.yaml")),
-        p(&d.join("a.yaml")),
-        p(&d.join("b.yaml")),
-        "--overlap",
-        "0.6",
-    ]);
-    assert!(o.status.success(), "{}", text(&o.stderr));
+    cut_plan(d, 25, "0.6");
     let (a, b) = (d.join("a.yaml"), d.join("b.yaml"));
     for verify in [true, false] {
         let mut args = vec!["merge", p(&a), p(&b), "--algorithm", "rmap", "--report"];
