@@ -68,6 +68,29 @@ fn main() {
         let (ns, ts, rs) = split(&s, false);
         println!("  odometry alone short (<=10 s) {ns}: {ts:.4} m {rs:.3} deg");
     }
+    if std::env::var("ALL_PARTICLES").is_ok() {
+        // every final particle's trajectory scored: is the chosen one the best, or are they all alike?
+        let mut all: Vec<(f64, usize, f64)> = (0..f.particles().count())
+            .map(|i| {
+                let anchors: Vec<(usize, Pose2)> =
+                    processed.iter().copied().zip(f.particle_trajectory(i).into_iter().map(|k| k.1)).collect();
+                let poses = poses_at_every_scan(&stamps, &odometry, &anchors).expect("processed scans");
+                let traj: Vec<StampedPose> =
+                    stamps.iter().zip(poses).map(|(&stamp, pose)| StampedPose { stamp, pose }).collect();
+                (relations::score(&traj, &rels, 0.001).translation.mean, i, f.lineage_log_likelihoods()[i])
+            })
+            .collect();
+        all.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let best = f.best_index();
+        let rank = all.iter().position(|a| a.1 == best).expect("the best is a particle");
+        println!(
+            "  particles: min {:.4} median {:.4} max {:.4} m; the chosen ranks {rank} of {}",
+            all[0].0,
+            all[all.len() / 2].0,
+            all[all.len() - 1].0,
+            all.len()
+        );
+    }
     let (ns, ts, rs) = split(&s, false);
     let (nl, tl, rl) = split(&s, true);
     println!("  short (<=10 s) {ns}: {ts:.4} m {rs:.3} deg; long {nl}: {tl:.4} m {rl:.3} deg");
@@ -82,6 +105,11 @@ fn main() {
                 w.translation,
                 w.rotation.to_degrees()
             );
+        }
+    }
+    if std::env::var("LONG").is_ok() {
+        for e in s.errors.iter().filter(|e| (e.t2 - e.t1).abs() > 10.0) {
+            println!("  long {:.1}-{:.1} s: {:.3} m {:.2} deg", e.t1, e.t2, e.translation, e.rotation.to_degrees());
         }
     }
     if std::env::var("WORST").is_ok() {
