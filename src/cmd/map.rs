@@ -4,7 +4,7 @@ use super::paths::{self, extension};
 use anyhow::{Context, Result, bail};
 use clap::Subcommand;
 use mrslam_core::map_io::{self, GreyImage, MapMode, MapYaml};
-use mrslam_core::pose::pose_xyt;
+use mrslam_core::pose::Xyt;
 use mrslam_core::{OccupancyGrid, map_io::grid_from_image};
 use mrslam_merge::pairs::{PairSpec, cut_pair};
 use std::path::{Path, PathBuf};
@@ -105,7 +105,7 @@ pub fn run(cmd: MapCommand) -> Result<ExitCode> {
             }
             map_io::write_ros_map(&pair.a, &a)?;
             map_io::write_ros_map(&pair.b, &b)?;
-            let (x, y, th) = pose_xyt(&pair.t_a_b);
+            let Xyt { x, y, theta: th } = Xyt::from_pose(&pair.t_a_b);
             println!("wrote {} and {} (overlap {:.3})", a.display(), b.display(), pair.overlap);
             println!("true transform b -> a: x {x:.4} m, y {y:.4} m, theta {th:.5} rad ({:.3} deg)", th.to_degrees());
         }
@@ -151,7 +151,7 @@ pub fn save_map(grid: &OccupancyGrid, path: &Path) -> Result<()> {
 /// The human summary `map info` prints.
 pub fn info_text(path: &Path, grid: &OccupancyGrid) -> String {
     let (free, occ, unknown) = grid.state_counts();
-    let (x, y, yaw) = pose_xyt(grid.origin());
+    let Xyt { x, y, theta: yaw } = Xyt::from_pose(grid.origin());
     let res = grid.resolution();
     let mut s = format!(
         "map:        {}\nsize:       {} x {} cells ({:.2} x {:.2} m)\nresolution: {} m/cell\norigin:     x {:.3} m, y {:.3} m, yaw {:.4} rad\ncells:      {} free, {} occupied, {} unknown\n",

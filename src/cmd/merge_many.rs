@@ -4,8 +4,9 @@
 use super::merge::MergeArgs;
 use anyhow::{Context, Result, bail};
 use mrslam_core::OccupancyGrid;
+use mrslam_core::Xyt;
 use mrslam_core::map_io::{self, write_file_atomic};
-use mrslam_merge::{MergeParams, Merger, MultiReport, TransformXyt, merge_many};
+use mrslam_merge::{MergeParams, Merger, MultiReport, merge_many};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -68,7 +69,7 @@ struct Report<'a> {
 }
 
 /// A transform as the summary prints it.
-fn xyt(t: &TransformXyt) -> String {
+fn xyt(t: &Xyt) -> String {
     format!("x {:.3} m, y {:.3} m, theta {:.4} rad ({:.2} deg)", t.x, t.y, t.theta, t.theta.to_degrees())
 }
 

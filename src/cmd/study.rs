@@ -5,6 +5,7 @@
 use anyhow::{Context, Result, bail};
 use clap::{Args, Subcommand};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use mrslam_core::Xyt;
 use mrslam_core::map_io::{self, write_file_atomic};
 use mrslam_core::relations;
 use mrslam_merge::MapEncoding;
@@ -345,7 +346,7 @@ fn overlap(a: OverlapArgs) -> Result<ExitCode> {
 
 /// A grid's size, resolution, origin and cells as bytes, for its fingerprint.
 fn grid_bytes(g: &mrslam_core::OccupancyGrid) -> Vec<u8> {
-    let (x, y, t) = mrslam_core::pose_xyt(g.origin());
+    let Xyt { x, y, theta: t } = Xyt::from_pose(g.origin());
     let mut b = format!("{} {} {} {x} {y} {t}\n", g.width(), g.height(), g.resolution()).into_bytes();
     for c in g.cells() {
         b.extend_from_slice(&c.to_bits().to_le_bytes());

@@ -3,7 +3,7 @@
 
 use crate::util::{mrslam, text};
 use mrslam_core::Pose2;
-use mrslam_core::pose::{pose_xyt, relative};
+use mrslam_core::pose::{Xyt, relative};
 use mrslam_slam::synthetic::{self, Drift, Lidar, SyntheticRun};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -24,7 +24,7 @@ fn carmen_lines(run: &SyntheticRun) -> Vec<String> {
         format!("PARAM robot_front_laser_max {}", lidar.range_max),
     ];
     for (o, s) in run.odometry.iter().zip(&run.scans) {
-        let (x, y, t) = pose_xyt(&o.pose);
+        let Xyt { x, y, theta: t } = Xyt::from_pose(&o.pose);
         let mut l = format!("FLASER {}", s.ranges.len());
         for r in &s.ranges {
             let _ = write!(l, " {r:.3}");
@@ -195,7 +195,7 @@ fn arrival_order_lines(run: &SyntheticRun) -> Vec<String> {
         (-1.0, format!("PARAM robot_front_laser_max {}", lidar.range_max)),
     ];
     let odom_line = |stamp: f64, p: &Pose2| {
-        let (x, y, t) = pose_xyt(p);
+        let Xyt { x, y, theta: t } = Xyt::from_pose(p);
         format!("ODOM {x:.6} {y:.6} {t:.6} 0 0 0 {stamp:.3} synthetic {stamp:.3}")
     };
     for (k, (o, s)) in run.odometry.iter().zip(&run.scans).enumerate() {
@@ -207,7 +207,7 @@ fn arrival_order_lines(run: &SyntheticRun) -> Vec<String> {
             timed.push((0.5 * (o.stamp + n.stamp), odom_line(0.5 * (o.stamp + n.stamp), &half)));
         }
         let stale = if k == 0 { o.pose } else { run.odometry[k - 1].pose };
-        let (x, y, t) = pose_xyt(&stale);
+        let Xyt { x, y, theta: t } = Xyt::from_pose(&stale);
         let mut l = format!("FLASER {}", s.ranges.len());
         for r in &s.ranges {
             let _ = write!(l, " {r:.3}");
@@ -241,7 +241,7 @@ fn poses_of(path: &Path) -> Vec<String> {
 fn true_relations(run: &SyntheticRun, gap: usize) -> String {
     let mut text = String::new();
     for (a, b) in run.truth.iter().zip(run.truth.iter().skip(gap)) {
-        let (x, y, t) = pose_xyt(&relative(&a.1, &b.1));
+        let Xyt { x, y, theta: t } = Xyt::from_pose(&relative(&a.1, &b.1));
         let _ = writeln!(text, "{:.3} {:.3} {x:.6} {y:.6} 0 0 0 {t:.6}", a.0, b.0);
     }
     text
@@ -301,7 +301,7 @@ fn a_robotlaser1_log_maps_end_to_end() {
         .iter()
         .zip(&run.scans)
         .map(|(o, s)| {
-            let (x, y, t) = pose_xyt(&o.pose);
+            let Xyt { x, y, theta: t } = Xyt::from_pose(&o.pose);
             let mut l = format!(
                 "ROBOTLASER1 0 {:.6} {:.6} {inc:.8} {} 0.01 0 {}",
                 -lidar.fov / 2.0,

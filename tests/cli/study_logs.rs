@@ -3,7 +3,7 @@
 
 use crate::util::{mrslam, text};
 use mrslam_core::Pose2;
-use mrslam_core::pose::pose_xyt;
+use mrslam_core::pose::Xyt;
 use mrslam_slam::synthetic::{self, Drift, Lidar, SyntheticRun};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -26,7 +26,7 @@ fn carmen_log(run: &SyntheticRun) -> String {
         lidar.range_max
     );
     for (o, scan) in run.odometry.iter().zip(&run.scans) {
-        let (x, y, t) = pose_xyt(&o.pose);
+        let Xyt { x, y, theta: t } = Xyt::from_pose(&o.pose);
         let _ = write!(s, "FLASER {}", scan.ranges.len());
         for r in &scan.ranges {
             let _ = write!(s, " {r:.3}");
@@ -42,7 +42,7 @@ fn relations(run: &SyntheticRun) -> String {
     for (a, b) in [(100, 250), (150, 200), (120, 300), (20, 60), (260, 300), (170, 190), (330, 140)] {
         let (ta, pa) = run.truth[a];
         let (tb, pb) = run.truth[b];
-        let (x, y, t) = pose_xyt(&pa.inv_mul(&pb));
+        let Xyt { x, y, theta: t } = Xyt::from_pose(&pa.inv_mul(&pb));
         let _ = writeln!(s, "{ta:.3} {tb:.3} {x:.6} {y:.6} 0 0 0 {t:.6}");
     }
     s

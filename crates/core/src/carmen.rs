@@ -540,7 +540,7 @@ fn parse_robot_laser(f: &[&str], line: usize) -> Result<ScanRecord, String> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::pose::pose_xyt;
+    use crate::pose::Xyt;
 
     const LOG: &str = "\
 # CARMEN Logfile
@@ -554,8 +554,11 @@ RLASER 2 7.0 8.0 0 0 0 0 0 0 4.0 host 4.0
 ODOM 0.0 0.0 0.0 0.0 0.0 0.0 1.0 host 1.0
 ";
 
-    fn assert_close(a: (f64, f64, f64), b: (f64, f64, f64)) {
-        assert!((a.0 - b.0).abs() < 1e-12 && (a.1 - b.1).abs() < 1e-12 && (a.2 - b.2).abs() < 1e-12, "{a:?} != {b:?}");
+    fn assert_close(a: Xyt, b: (f64, f64, f64)) {
+        assert!(
+            (a.x - b.0).abs() < 1e-12 && (a.y - b.1).abs() < 1e-12 && (a.theta - b.2).abs() < 1e-12,
+            "{a:?} != {b:?}"
+        );
     }
 
     #[test]
@@ -568,15 +571,15 @@ ODOM 0.0 0.0 0.0 0.0 0.0 0.0 1.0 host 1.0
         let stamps: Vec<f64> = log.scans.iter().map(|s| s.scan.stamp).collect();
         assert_eq!(stamps, [2.5, 3.0, 4.0]);
         assert_eq!(log.odometry.iter().map(|o| o.stamp).collect::<Vec<_>>(), [1.0, 2.0]);
-        let (x, y, t) = pose_xyt(&log.odometry[1].pose);
+        let Xyt { x, y, theta: t } = Xyt::from_pose(&log.odometry[1].pose);
         assert!((x - 0.5).abs() < 1e-12 && (y - 0.25).abs() < 1e-12 && (t - 0.1).abs() < 1e-12);
 
         let rl = &log.scans[0];
         assert_eq!(rl.source, LaserSource::Robot);
         assert_eq!(rl.scan.ranges, [4.0, 5.0, 6.0]);
         assert_eq!((rl.scan.angle_min, rl.scan.angle_increment, rl.scan.range_max), (-1.5, 1.5, 20.0));
-        assert_close(pose_xyt(&rl.odometry.pose), (2.0, 2.0, 0.5));
-        let (ox, oy, _) = pose_xyt(&rl.laser_offset);
+        assert_close(Xyt::from_pose(&rl.odometry.pose), (2.0, 2.0, 0.5));
+        let Xyt { x: ox, y: oy, .. } = Xyt::from_pose(&rl.laser_offset);
         assert!((ox.hypot(oy) - 0.1f64.hypot(0.2)).abs() < 1e-9);
 
         let fl = &log.scans[1];
@@ -585,13 +588,13 @@ ODOM 0.0 0.0 0.0 0.0 0.0 0.0 1.0 host 1.0
         assert!((fl.scan.angle_increment - 1f64.to_radians()).abs() < 1e-12);
         assert!((fl.scan.angle_min + std::f64::consts::FRAC_PI_2).abs() < 1e-12);
         assert_eq!(fl.scan.range_max, 8.0);
-        assert_close(pose_xyt(&fl.odometry.pose), (0.9, 1.0, 0.2));
-        assert_close(pose_xyt(&fl.logged_laser_pose), (1.1, 1.2, 0.3));
+        assert_close(Xyt::from_pose(&fl.odometry.pose), (0.9, 1.0, 0.2));
+        assert_close(Xyt::from_pose(&fl.logged_laser_pose), (1.1, 1.2, 0.3));
         assert_eq!(fl.line, 5);
 
         let rr = &log.scans[2];
         assert_eq!(rr.source, LaserSource::Rear);
-        assert!((pose_xyt(&rr.laser_offset).2 - std::f64::consts::PI).abs() < 1e-12);
+        assert!((Xyt::from_pose(&rr.laser_offset).theta - std::f64::consts::PI).abs() < 1e-12);
     }
 
     #[test]
@@ -661,9 +664,8 @@ ODOM 0.0 0.0 0.0 0.0 0.0 0.0 1.0 host 1.0
         assert!((log.repairs.max_step_back - 0.15).abs() < 0.06, "{:?}", log.repairs);
         assert_eq!((log.repairs.interpolated_odometry, log.repairs.line_odometry), (14, 0));
         for s in &log.scans {
-            let (x, y, t) = pose_xyt(&s.odometry.pose);
             let e = s.scan.stamp - 1.0;
-            assert_close((x, y, t), (e, 0.0, 0.1 * e));
+            assert_close(Xyt::from_pose(&s.odometry.pose), (e, 0.0, 0.1 * e));
             assert_eq!(s.odometry.stamp, s.scan.stamp);
         }
         // The same lines in stamp order read the same.
@@ -684,7 +686,7 @@ ODOM 0.0 0.0 0.0 0.0 0.0 0.0 1.0 host 1.0
         let text: String = lines.iter().map(|(_, l)| format!("{l}\n")).collect();
         let own = CarmenLog::parse_with(text.as_bytes(), Path::new("i.clf"), &opts).unwrap();
         assert_eq!(own.repairs.line_odometry, 14);
-        assert_close(pose_xyt(&own.scans[0].odometry.pose), (9.0, 9.0, 9.0 - 2.0 * std::f64::consts::PI));
+        assert_close(Xyt::from_pose(&own.scans[0].odometry.pose), (9.0, 9.0, 9.0 - 2.0 * std::f64::consts::PI));
     }
 
     #[test]
@@ -712,7 +714,7 @@ FLASER 2 1.0 3.0 0 0 0 0 0 0 1.5 h 1
         assert_eq!((r.duplicate_scans, r.shared_scan_stamps, r.duplicate_odometry), (1, 1, 1));
         assert_eq!(log.scans.len(), 2);
         // The first ODOM line of a repeated stamp is kept: x goes 0 -> 2 over 1 s.
-        assert_close(pose_xyt(&log.scans[0].odometry.pose), (1.0, 0.0, 0.0));
+        assert_close(Xyt::from_pose(&log.scans[0].odometry.pose), (1.0, 0.0, 0.0));
         assert!(r.describe().contains("1 repeated scans dropped"), "{}", r.describe());
     }
 
@@ -725,7 +727,7 @@ PARAM robot_frontlaser_angular_offset 0.05 h 1
 FLASER 2 1.0 2.0 0 0 0 0 0 0 1.5 h 1
 ";
         let log = CarmenLog::parse(text.as_bytes(), Path::new("p.clf")).unwrap();
-        assert_close(pose_xyt(&log.scans[0].laser_offset), (0.2, 0.1, 0.05));
+        assert_close(Xyt::from_pose(&log.scans[0].laser_offset), (0.2, 0.1, 0.05));
     }
 
     #[test]
@@ -741,7 +743,7 @@ FLASER 2 1.0 2.0 0 0 0 0 0 0 2.5 h 1
         assert_eq!(log.repairs.reversed_increments, 1);
         let xs: Vec<f64> = log.odometry.iter().map(|o| o.pose.translation.x).collect();
         assert_eq!(xs, [0.0, 1.0, 0.0, 1.0]);
-        assert_close(pose_xyt(&log.scans[0].odometry.pose), (0.5, 0.0, 0.0));
+        assert_close(Xyt::from_pose(&log.scans[0].odometry.pose), (0.5, 0.0, 0.0));
         assert!(log.repairs.describe().contains("1 ODOM increments reported reversing"));
         let keep = ReadOptions { repair_reversing: false, ..ReadOptions::default() };
         let log = CarmenLog::parse_with(text.as_bytes(), Path::new("r.clf"), &keep).unwrap();
@@ -750,7 +752,7 @@ FLASER 2 1.0 2.0 0 0 0 0 0 0 2.5 h 1
         // A scan taken 0.5 s before its stamp takes the odometry of then.
         let late = ReadOptions { scan_latency: 0.5, ..ReadOptions::default() };
         let log = CarmenLog::parse_with(text.as_bytes(), Path::new("r.clf"), &late).unwrap();
-        assert_close(pose_xyt(&log.scans[0].odometry.pose), (0.0, 0.0, 0.0));
+        assert_close(Xyt::from_pose(&log.scans[0].odometry.pose), (0.0, 0.0, 0.0));
         assert_eq!(log.scans[0].odometry.stamp, 2.5);
     }
 }

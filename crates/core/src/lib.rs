@@ -17,7 +17,7 @@ pub mod toml_lines;
 pub use carmen::{CarmenError, CarmenLog, LaserSource, OdometrySource, ReadOptions, Repairs, ScanRecord};
 pub use grid::{CellState, GridError, LogOddsParams, OccupancyGrid};
 pub use map_io::{MapIoError, MapMode, MapYaml};
-pub use pose::{Pose2, pose, pose_xyt};
+pub use pose::{Pose2, Xyt, pose};
 pub use raycast::CellTraversal;
 pub use relations::{Relation, RelationsError, RelationsScore, StampedPose};
 pub use scan::{LaserScan, Odometry};

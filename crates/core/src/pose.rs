@@ -11,9 +11,31 @@ pub fn pose(x: f64, y: f64, theta: f64) -> Pose2 {
     Isometry2::new(Vector2::new(x, y), theta)
 }
 
-/// Returns (x, y, theta) of a pose, theta in (-pi, pi].
-pub fn pose_xyt(p: &Pose2) -> (f64, f64, f64) {
-    (p.translation.x, p.translation.y, p.rotation.angle())
+/// A pose or transform as its three numbers: x, y (metres) and heading theta (radians).
+///
+/// The plain-data form of a [`Pose2`]: what matchers iterate on, what reports and files hold.
+#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize, serde::Deserialize)]
+pub struct Xyt {
+    /// Translation along x, metres.
+    pub x: f64,
+    /// Translation along y, metres.
+    pub y: f64,
+    /// Heading (rotation), radians.
+    pub theta: f64,
+}
+
+impl Xyt {
+    /// The (x, y, theta) of a pose, theta in (-pi, pi].
+    #[inline]
+    pub fn from_pose(p: &Pose2) -> Self {
+        Xyt { x: p.translation.x, y: p.translation.y, theta: p.rotation.angle() }
+    }
+
+    /// The pose of (x, y, theta).
+    #[inline]
+    pub fn to_pose(&self) -> Pose2 {
+        pose(self.x, self.y, self.theta)
+    }
 }
 
 /// Composes `a ⊕ b`: the pose `b`, expressed in frame `a`, taken to `a`'s parent frame.
@@ -49,8 +71,8 @@ pub fn angle_diff(a: f64, b: f64) -> f64 {
 
 /// The pose a fraction `s` of the way from `a` to `b`: linear in x and y, the short way round in heading.
 pub fn interpolate(a: &Pose2, b: &Pose2, s: f64) -> Pose2 {
-    let (ax, ay, at) = pose_xyt(a);
-    let (bx, by, bt) = pose_xyt(b);
+    let Xyt { x: ax, y: ay, theta: at } = Xyt::from_pose(a);
+    let Xyt { x: bx, y: by, theta: bt } = Xyt::from_pose(b);
     pose(ax + s * (bx - ax), ay + s * (by - ay), at + s * angle_diff(bt, at))
 }
 
@@ -77,10 +99,10 @@ mod tests {
         let d = pose(0.3, 0.1, -0.2);
         let b = compose(&a, &d);
         let r = relative(&a, &b);
-        let (x, y, t) = pose_xyt(&r);
+        let Xyt { x, y, theta: t } = Xyt::from_pose(&r);
         assert!((x - 0.3).abs() < 1e-12 && (y - 0.1).abs() < 1e-12 && (t + 0.2).abs() < 1e-12);
         let id = compose(&inverse(&a), &a);
-        assert!(pose_xyt(&id).0.abs() < 1e-12 && pose_xyt(&id).2.abs() < 1e-12);
+        assert!(Xyt::from_pose(&id).x.abs() < 1e-12 && Xyt::from_pose(&id).theta.abs() < 1e-12);
     }
 
     #[test]

@@ -9,7 +9,7 @@
 //!
 //! A trajectory file holds one pose a line, `stamp x y theta`, `#` starting a comment.
 
-use crate::pose::{Pose2, normalize_angle, pose, pose_xyt};
+use crate::pose::{Pose2, Xyt, normalize_angle, pose};
 use std::path::{Path, PathBuf};
 
 /// One relation of a relations file.
@@ -137,7 +137,7 @@ pub fn format_trajectory(header: &str, poses: &[StampedPose]) -> String {
         let _ = writeln!(text, "# {l}");
     }
     for p in poses {
-        let (x, y, t) = pose_xyt(&p.pose);
+        let Xyt { x, y, theta: t } = Xyt::from_pose(&p.pose);
         let _ = writeln!(text, "{:.6} {x:.6} {y:.6} {t:.6}", p.stamp);
     }
     text
@@ -233,7 +233,7 @@ pub fn score(trajectory: &[StampedPose], relations: &[Relation], tolerance: f64)
         match (pose_at(trajectory, r.t1, tolerance), pose_at(trajectory, r.t2, tolerance)) {
             (Some(a), Some(b)) => {
                 let e = r.delta.inv_mul(&a.inv_mul(&b));
-                let (x, y, t) = pose_xyt(&e);
+                let Xyt { x, y, theta: t } = Xyt::from_pose(&e);
                 errors.push(RelationError {
                     t1: r.t1,
                     t2: r.t2,

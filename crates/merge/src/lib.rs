@@ -33,7 +33,7 @@ pub use matching::MatchParams;
 pub use merger::{Alignment, Evidence, MergeOutcome, MergeParams, Merger, NoAlignment, merge};
 pub use multi::{MultiOutcome, MultiReport, PairReport, TreeEdge, merge_many};
 pub use refine::RefineParams;
-pub use report::{MergeReport, TransformXyt};
+pub use report::MergeReport;
 pub use rmap::{RmapMerger, RmapParams};
 pub use sift_merger::{SiftMerger, SiftMergerParams};
 pub use verify::VerifyParams;

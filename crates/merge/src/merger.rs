@@ -2,8 +2,9 @@
 
 use crate::fuse::{FusionRule, fuse};
 use crate::refine::{RefineParams, refine, wall_points};
-use crate::report::{MergeReport, TransformXyt};
+use crate::report::MergeReport;
 use crate::verify::{Agreement, VerifyParams, agreement, ambiguity, confidence, rejection_reason};
+use mrslam_core::Xyt;
 use mrslam_core::{OccupancyGrid, Pose2};
 use nalgebra::Point2;
 use std::collections::BTreeMap;
@@ -280,7 +281,7 @@ pub fn merge(merger: &dyn Merger, a: &OccupancyGrid, b: &OccupancyGrid, p: &Merg
     let report = MergeReport {
         accepted: reason.is_none(),
         algorithm: merger.name().to_string(),
-        transform: Some(TransformXyt::from_pose(&alignment.transform)),
+        transform: Some(Xyt::from_pose(&alignment.transform)),
         scale: Some(alignment.scale),
         matches: alignment.matches,
         inliers: alignment.inliers,

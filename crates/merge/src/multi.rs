@@ -4,7 +4,8 @@
 
 use crate::fuse::fuse;
 use crate::merger::{MergeParams, Merger, merge};
-use crate::report::{MergeReport, TransformXyt};
+use crate::report::MergeReport;
+use mrslam_core::Xyt;
 use mrslam_core::{OccupancyGrid, Pose2};
 use rayon::prelude::*;
 use std::time::Instant;
@@ -32,7 +33,7 @@ pub struct TreeEdge {
     /// The pair's confidence (the edge's weight).
     pub confidence: f64,
     /// `T_parent_child`: points of the child's frame into the parent's.
-    pub transform: TransformXyt,
+    pub transform: Xyt,
 }
 
 /// What [`merge_many`] reports (also the JSON `mrslam merge` writes for three or more maps).
@@ -47,7 +48,7 @@ pub struct MultiReport {
     /// The spanning forest's edges: map 0's tree first (breadth first from map 0), then the other components'.
     pub tree: Vec<TreeEdge>,
     /// `T_0_i` for each map i joined to map 0 by the tree (map 0's own is the identity); None for the rest.
-    pub transforms: Vec<Option<TransformXyt>>,
+    pub transforms: Vec<Option<Xyt>>,
     /// Connected components of the accepted pairs, each sorted, map 0's first, the rest by smallest member.
     pub components: Vec<Vec<usize>>,
     /// Maps not joined to map 0, ascending (empty when every map is connected).
@@ -138,13 +139,7 @@ fn orient(n: usize, forest: &[Edge]) -> (Vec<Vec<usize>>, Vec<TreeEdge>, Vec<Pos
                 }
                 seen[child] = true;
                 to_root[child] = to_root[parent] * t_parent_child;
-                tree.push(TreeEdge {
-                    parent,
-                    child,
-                    pair,
-                    confidence,
-                    transform: TransformXyt::from_pose(&t_parent_child),
-                });
+                tree.push(TreeEdge { parent, child, pair, confidence, transform: Xyt::from_pose(&t_parent_child) });
                 queue.push(child);
             }
         }
@@ -176,8 +171,8 @@ pub fn merge_many(merger: &dyn Merger, maps: &[OccupancyGrid], params: &MergePar
     let forest = spanning_forest(n, &edges);
     let (components, tree, to_root) = orient(n, &forest);
     let joined: &[usize] = components.first().map_or(&[], |c| c.as_slice());
-    let transforms: Vec<Option<TransformXyt>> =
-        (0..n).map(|i| joined.contains(&i).then(|| TransformXyt::from_pose(&to_root[i]))).collect();
+    let transforms: Vec<Option<Xyt>> =
+        (0..n).map(|i| joined.contains(&i).then(|| Xyt::from_pose(&to_root[i]))).collect();
     let not_connected: Vec<usize> = (0..n).filter(|i| !joined.contains(i)).collect();
     // Fused in tree order (breadth first from map 0): each map lands next to maps already in.
     let merged = (joined.len() > 1).then(|| {
@@ -314,6 +309,6 @@ mod tests {
         let one = [OccupancyGrid::new(10, 10, 0.1, pose(0.0, 0.0, 0.0)).unwrap()];
         let out = merge_many(&known, &one, &MergeParams::default());
         assert!(out.merged.is_none() && out.report.all_connected());
-        assert_eq!(out.report.transforms, vec![Some(TransformXyt::from_pose(&Pose2::identity()))]);
+        assert_eq!(out.report.transforms, vec![Some(Xyt::from_pose(&Pose2::identity()))]);
     }
 }

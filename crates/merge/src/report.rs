@@ -1,30 +1,7 @@
 //! The merge report: what `--report` writes, laid out in ARCHITECTURE.md, "Merge report".
 
-use mrslam_core::{Pose2, pose, pose_xyt};
+use mrslam_core::Xyt;
 use std::collections::BTreeMap;
-
-/// A planar transform as x, y (metres) and theta (radians).
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct TransformXyt {
-    /// Translation along x, metres.
-    pub x: f64,
-    /// Translation along y, metres.
-    pub y: f64,
-    /// Rotation, radians.
-    pub theta: f64,
-}
-
-impl TransformXyt {
-    /// From a pose.
-    pub fn from_pose(p: &Pose2) -> Self {
-        let (x, y, theta) = pose_xyt(p);
-        TransformXyt { x, y, theta }
-    }
-    /// To a pose.
-    pub fn to_pose(&self) -> Pose2 {
-        pose(self.x, self.y, self.theta)
-    }
-}
 
 /// Result of one merge, accepted or not. `transform` maps points of b's frame into a's frame.
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -34,7 +11,7 @@ pub struct MergeReport {
     /// Algorithm name.
     pub algorithm: String,
     /// Estimated `T_a_b`, when the algorithm produced one (also when rejected).
-    pub transform: Option<TransformXyt>,
+    pub transform: Option<Xyt>,
     /// Scale of the estimated model.
     pub scale: Option<f64>,
     /// Tentative correspondences.

@@ -130,7 +130,7 @@ impl Encoders {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use mrslam_core::pose_xyt;
+    use mrslam_core::Xyt;
     use std::f64::consts::PI;
 
     #[test]
@@ -138,7 +138,7 @@ mod tests {
         let mut e = Encoders::new(EncoderParams::default(), 0.05, 0.3, 0.0).unwrap();
         // one full revolution plus a fraction of a tick
         e.advance([TAU + 0.5 * TAU / 2048.0; 2], 1.0);
-        let (x, y, t) = pose_xyt(&e.odometry().pose);
+        let Xyt { x, y, theta: t } = Xyt::from_pose(&e.odometry().pose);
         assert!((x - TAU * 0.05).abs() < 1e-12 && y.abs() < 1e-12 && t.abs() < 1e-12);
         assert_eq!(e.ticks(), [2048, 2048]);
         assert_eq!(e.odometry().stamp, 1.0);
@@ -153,7 +153,7 @@ mod tests {
         for _ in 0..100 {
             e.advance([-phi / 100.0, phi / 100.0], 0.0);
         }
-        let (x, y, t) = pose_xyt(&e.odometry().pose);
+        let Xyt { x, y, theta: t } = Xyt::from_pose(&e.odometry().pose);
         assert!(x.abs() < 1e-4 && y.abs() < 1e-4 && (t - PI / 2.0).abs() < 1e-3, "{x} {y} {t}");
     }
 
@@ -162,7 +162,7 @@ mod tests {
         let p = EncoderParams::default().with_calibration_error(0.01, 0.01, 0.0);
         let mut e = Encoders::new(p, 0.05, 0.3, 0.0).unwrap();
         e.advance([100.0, 100.0], 0.0);
-        let (x, _, _) = pose_xyt(&e.odometry().pose);
+        let Xyt { x, .. } = Xyt::from_pose(&e.odometry().pose);
         assert!((x / 5.0 - 1.01).abs() < 1e-3);
         assert!(EncoderParams { ticks_per_rev: 0, ..p }.validate().is_err());
     }
@@ -175,7 +175,7 @@ mod tests {
         for _ in 0..1000 {
             e.advance([0.85 * PI / 0.05 / 1000.0, 1.15 * PI / 0.05 / 1000.0], 0.0);
         }
-        let (x, y, t) = pose_xyt(&e.odometry().pose);
+        let Xyt { x, y, theta: t } = Xyt::from_pose(&e.odometry().pose);
         assert!(x.abs() < 1e-4 && (y - 2.0).abs() < 1e-4 && (t.abs() - PI).abs() < 1e-4, "{x} {y} {t}");
     }
 }

@@ -11,6 +11,7 @@
 
 use crate::error::{SimError, bad_param, check_non_negative, check_positive};
 use mrslam_core::Pose2;
+use mrslam_core::Xyt;
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
@@ -142,7 +143,7 @@ impl LidarModel {
         if !(0.0..=1.0).contains(&self.dropout_prob) {
             return Err(bad_param("LidarModel.dropout_prob", "must lie in [0, 1]"));
         }
-        let (x, y, t) = mrslam_core::pose_xyt(&self.mount);
+        let Xyt { x, y, theta: t } = Xyt::from_pose(&self.mount);
         if !(x.is_finite() && y.is_finite() && t.is_finite()) {
             return Err(bad_param("LidarModel.mount", "must be finite"));
         }

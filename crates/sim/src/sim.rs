@@ -15,7 +15,7 @@ use crate::slip::{SlipParams, SlipState};
 use crate::world::World;
 use crate::world_file::WorldSpec;
 use mrslam_core::pose::interpolate;
-use mrslam_core::{LaserScan, Odometry, Pose2, pose, pose_xyt};
+use mrslam_core::{LaserScan, Odometry, Pose2, Xyt, pose};
 use nalgebra::{Point2, Vector2};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -127,7 +127,7 @@ pub fn robot_rng(seed: u64, name: &str, purpose: &str) -> ChaCha8Rng {
 }
 
 fn to_glam(p: &Pose2) -> rp::Pose {
-    let (x, y, t) = pose_xyt(p);
+    let Xyt { x, y, theta: t } = Xyt::from_pose(p);
     rp::Pose::new(rp::Vector::new(x as f32, y as f32), t as f32)
 }
 
@@ -230,7 +230,7 @@ impl Sim {
         model.validate()?;
         lidar.validate()?;
         slip.validate()?;
-        let (sx, sy, st) = pose_xyt(&start);
+        let Xyt { x: sx, y: sy, theta: st } = Xyt::from_pose(&start);
         if !(sx.is_finite() && sy.is_finite() && st.is_finite()) {
             return Err(bad_param("start", "must be finite"));
         }
@@ -425,7 +425,7 @@ impl Sim {
 
 /// A robot's footprint at `pose` as an obstacle (for other robots' lidars).
 fn robot_obstacle(fp: &Footprint, pose: &Pose2) -> Obstacle {
-    let (x, y, t) = pose_xyt(pose);
+    let Xyt { x, y, theta: t } = Xyt::from_pose(pose);
     match *fp {
         Footprint::Circle { radius } => Obstacle::Circle { center: Point2::new(x, y), radius },
         Footprint::Box { length, width } => {

@@ -3,7 +3,7 @@
 
 mod common;
 
-use mrslam_core::{pose, pose_xyt};
+use mrslam_core::{Xyt, pose};
 use mrslam_sim::{EncoderParams, LidarModel, RobotModel, Sim, SlipParams};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -30,7 +30,7 @@ fn a_robot_driven_into_a_wall_stops_and_never_passes_through() {
         for _ in 0..500 {
             let ev = sim.step();
             touched |= ev.robots[0].contact;
-            let (x, y, _) = pose_xyt(&sim.true_pose(id).unwrap());
+            let Xyt { x, y, .. } = Xyt::from_pose(&sim.true_pose(id).unwrap());
             // the footprint's farthest point never crosses the inner face by more than 1 cm
             assert!(x < 5.95 + 0.01, "seed {seed}: centre at x = {x}");
             assert!(y > 0.05 && y < 3.95, "seed {seed}: y = {y}");
@@ -92,9 +92,9 @@ fn run(seed: u64) -> Run {
         sim.set_velocity_command(b, 0.25, -0.5 * (t * 0.5).cos()).unwrap();
         sim.step();
         for id in [a, b] {
-            let (x, y, th) = pose_xyt(&sim.true_pose(id).unwrap());
+            let Xyt { x, y, theta: th } = Xyt::from_pose(&sim.true_pose(id).unwrap());
             poses.push([x, y, th]);
-            let (x, y, th) = pose_xyt(&sim.odometry(id).unwrap().pose);
+            let Xyt { x, y, theta: th } = Xyt::from_pose(&sim.odometry(id).unwrap().pose);
             odos.push([x, y, th]);
             if let Some(s) = sim.take_scan(id).unwrap() {
                 scans.push(s.ranges);

@@ -4,7 +4,7 @@
 mod common;
 
 use mrslam_core::pose::relative;
-use mrslam_core::{pose, pose_xyt};
+use mrslam_core::{Xyt, pose};
 use mrslam_sim::{EncoderParams, LidarModel, RobotModel, Sim, SlipParams, WorldSpec};
 
 #[test]
@@ -17,7 +17,7 @@ fn straight_five_metres_without_slip_reaches_goal_and_odometry_agrees() {
         let id = sim.add_robot("r", model.clone(), lidar, SlipParams::none(), EncoderParams::default(), start).unwrap();
         let goal_x = 6.0;
         for _ in 0..3000 {
-            let (x, _, _) = pose_xyt(&sim.true_pose(id).unwrap());
+            let Xyt { x, .. } = Xyt::from_pose(&sim.true_pose(id).unwrap());
             let rem = goal_x - x;
             // slow down so the acceleration limit can stop the robot at the goal
             let v = (rem.signum() * (2.0 * 0.9 * model.max_accel * rem.abs()).sqrt())
@@ -27,7 +27,7 @@ fn straight_five_metres_without_slip_reaches_goal_and_odometry_agrees() {
             assert!(!ev.robots[0].contact);
         }
         let truth = sim.true_pose(id).unwrap();
-        let (x, y, th) = pose_xyt(&truth);
+        let Xyt { x, y, theta: th } = Xyt::from_pose(&truth);
         assert!(
             (x - goal_x).abs() < 0.01 && (y - 1.5).abs() < 0.01 && th.abs() < 1e-3,
             "{} ended at {x} {y} {th}",

@@ -3,7 +3,7 @@
 
 mod common;
 
-use mrslam_core::{LaserScan, Pose2, pose, pose_xyt};
+use mrslam_core::{LaserScan, Pose2, Xyt, pose};
 use mrslam_sim::{EncoderParams, LidarModel, RayBackend, RobotModel, Sim, SimConfig, SlipParams};
 
 const T: f64 = 0.1; // wall thickness
@@ -16,7 +16,7 @@ fn inner(px: f64, py: f64, a: f64) -> f64 {
 
 /// Checks every beam against the room's geometry; returns (valid, max-range, dropout) counts.
 fn check_scan(scan: &LaserScan, lidar: &LidarModel, sensor: &Pose2) -> (usize, usize, usize) {
-    let (sx, sy, st) = pose_xyt(sensor);
+    let Xyt { x: sx, y: sy, theta: st } = Xyt::from_pose(sensor);
     let (mut valid, mut maxr, mut drop) = (0, 0, 0);
     for i in 0..scan.len() {
         let a = st + scan.angle(i);
@@ -107,7 +107,7 @@ fn range_limits_are_honoured() {
     let (mut sim, id) = sim_with(RobotModel::prawn(), lidar.clone(), at, RayBackend::Grid);
     let scan = first_scan(&mut sim, id);
     let sensor = at * lidar.mount;
-    let (sx, sy, st) = pose_xyt(&sensor);
+    let Xyt { x: sx, y: sy, theta: st } = Xyt::from_pose(&sensor);
     let (mut close, mut far, mut ok) = (0, 0, 0);
     for i in 0..scan.len() {
         let r = inner(sx, sy, st + scan.angle(i));

@@ -5,6 +5,7 @@
 //! scores the filter's odometry alone (scan-matched with `scan_odometry`), `WORST=1` / `WORST_ROT=1` print the
 //! worst relations, `DEBUG_RANGE=T0,T1` prints raw and filter odometry per scan stamped in [T0, T1].
 
+use mrslam_core::Xyt;
 use mrslam_core::relations::{self, StampedPose};
 use mrslam_core::{CarmenLog, OdometrySource, Pose2, ReadOptions};
 use mrslam_slam::{Preset, Rbpf, poses_at_every_scan};
@@ -41,8 +42,8 @@ fn main() {
             let (a, b) = r.split_once(',').expect("a,b");
             let st = rec.scan.stamp;
             if st >= a.parse::<f64>().expect("a") && st <= b.parse::<f64>().expect("b") {
-                let (x, y, t) = mrslam_core::pose::pose_xyt(&rec.odometry.pose);
-                let (cx, cy, ct) = mrslam_core::pose::pose_xyt(odometry.last().expect("pushed"));
+                let Xyt { x, y, theta: t } = Xyt::from_pose(&rec.odometry.pose);
+                let Xyt { x: cx, y: cy, theta: ct } = Xyt::from_pose(odometry.last().expect("pushed"));
                 let valid = (0..rec.scan.len()).filter(|&k| rec.scan.is_valid(k)).count();
                 println!(
                     "{st:.3} raw {x:.3} {y:.3} {:.2} corrected {cx:.3} {cy:.3} {:.2} valid {valid} {:?}",

@@ -2,8 +2,8 @@
 #![allow(clippy::unwrap_used, reason = "a development aid / test: a failed unwrap names the problem")]
 
 use mrslam_core::pose;
-use mrslam_core::pose::pose_xyt;
-use mrslam_slam::scan_matcher::{PreparedScan, ScanMatcher, Xyt};
+use mrslam_core::pose::Xyt;
+use mrslam_slam::scan_matcher::{PreparedScan, ScanMatcher};
 use mrslam_slam::synthetic::{self, Drift, Lidar};
 use mrslam_slam::tile_map::TileMap;
 
@@ -14,13 +14,13 @@ fn main() {
     let run = synthetic::simulate(&map, &path, 0.1, &Lidar::hokuyo(), pose(0.0, 0.0, 0.0), &Drift::none(), 1);
     let m = ScanMatcher {
         sigma: env("SIGMA", 0.05),
-        ..ScanMatcher::from_params(&mrslam_slam::SlamParams::default(), Xyt { x: 0.0, y: 0.0, t: 0.0 })
+        ..ScanMatcher::from_params(&mrslam_slam::SlamParams::default(), Xyt { x: 0.0, y: 0.0, theta: 0.0 })
     };
     // map from the first 150 true scans
     let mut tm = TileMap::new(0.05);
     let upto = env("UPTO", 150.0) as usize;
     for k in 0..env("MAPN", upto as f64) as usize {
-        let (x, y, t) = pose_xyt(&run.truth[k].1);
+        let Xyt { x, y, theta: t } = Xyt::from_pose(&run.truth[k].1);
         let ps = PreparedScan::new(&run.scans[k], 4.0, 4.0, 0);
         for b in &ps.hits {
             let (s, c) = t.sin_cos();
@@ -30,10 +30,10 @@ fn main() {
     let (mut ex, mut ey, mut et) = (0.0, 0.0, 0.0);
     let mut n = 0.0;
     for k in (upto..upto + 60).step_by(3) {
-        let (x, y, t) = pose_xyt(&run.truth[k].1);
+        let Xyt { x, y, theta: t } = Xyt::from_pose(&run.truth[k].1);
         let ps = PreparedScan::new(&run.scans[k], 4.0, 4.0, 1);
         for (dx, dy, dt) in [(0.04, 0.0, 0.0), (-0.03, 0.02, 0.01), (0.0, 0.0, -0.02), (0.02, -0.03, 0.015)] {
-            let init = Xyt { x: x + dx, y: y + dy, t: t + dt };
+            let init = Xyt { x: x + dx, y: y + dy, theta: t + dt };
             let sel = if std::env::var("GUARD").is_ok() {
                 m.beams_in_map(&tm, &init, &ps.matched)
             } else {
@@ -42,7 +42,7 @@ fn main() {
             let (p, _) = m.optimize(&tm, &init, &sel);
             ex += (p.x - x).abs();
             ey += (p.y - y).abs();
-            et += (p.t - t).abs();
+            et += (p.theta - t).abs();
             n += 1.0;
         }
     }

@@ -5,9 +5,9 @@
 #![allow(clippy::unwrap_used, reason = "a development aid / test: a failed unwrap names the problem")]
 
 use mrslam_core::pose;
-use mrslam_core::pose::pose_xyt;
+use mrslam_core::pose::Xyt;
 use mrslam_slam::SlamParams;
-use mrslam_slam::scan_matcher::{MatcherKind, PreparedScan, ScanMatcher, Xyt};
+use mrslam_slam::scan_matcher::{MatcherKind, PreparedScan, ScanMatcher};
 use mrslam_slam::synthetic::{self, Drift, Lidar};
 use mrslam_slam::tile_map::TileMap;
 use rand::SeedableRng;
@@ -59,7 +59,7 @@ fn main() {
     }
     let matcher = ScanMatcher {
         minimum_score: f64::NEG_INFINITY,
-        ..ScanMatcher::from_params(&params, pose_to_xyt(&run.laser_offset))
+        ..ScanMatcher::from_params(&params, Xyt::from_pose(&run.laser_offset))
     };
     let mut tm = TileMap::new(params.delta);
     let mut rng = ChaCha8Rng::seed_from_u64(3);
@@ -72,7 +72,7 @@ fn main() {
     let mut est: Option<Xyt> = None;
     let mut prev_truth: Option<Xyt> = None;
     for k in (0..run.scans.len()).step_by(every) {
-        let truth = pose_to_xyt(&run.truth[k].1);
+        let truth = Xyt::from_pose(&run.truth[k].1);
         let ps = PreparedScan::new(&run.scans[k], params.max_range, params.max_urange, params.lskip);
         let pe: usize = std::env::var("PROFILE").ok().and_then(|v| v.parse().ok()).unwrap_or(0);
         if pe > 0
@@ -84,7 +84,7 @@ fn main() {
             let mut line = format!("k {k:4} at ({:5.1},{:5.1}) score(dθ mrad):", truth.x, truth.y);
             let mut best = (f64::MIN, 0.0);
             for i in -30..=30 {
-                let q = Xyt { t: truth.t + i as f64 * 1e-4, ..truth };
+                let q = Xyt { theta: truth.theta + i as f64 * 1e-4, ..truth };
                 let e = matcher.field_eval(&scratch.field, &q, &ps.matched);
                 if e.score > best.0 {
                     best = (e.score, i as f64 * 0.1);
@@ -97,8 +97,8 @@ fn main() {
                 let mut l2 = String::from("   score(dx cm):");
                 for i in -6..=6 {
                     let q = Xyt {
-                        x: truth.x + i as f64 * 0.01 * truth.t.cos(),
-                        y: truth.y + i as f64 * 0.01 * truth.t.sin(),
+                        x: truth.x + i as f64 * 0.01 * truth.theta.cos(),
+                        y: truth.y + i as f64 * 0.01 * truth.theta.sin(),
                         ..truth
                     };
                     let e = matcher.field_eval(&scratch.field, &q, &ps.matched);
@@ -112,18 +112,18 @@ fn main() {
                 best.1,
                 r.x - truth.x,
                 r.y - truth.y,
-                r.t - truth.t
+                r.theta - truth.theta
             );
         }
         if std::env::var("DUMP").ok().and_then(|v| v.parse::<usize>().ok()) == Some(k) {
             matcher.build_field(&tm, &truth, &ps, &mut scratch.field);
             let f = &scratch.field;
             let lp = matcher.laser_pose(&truth);
-            let (s, c) = lp.t.sin_cos();
+            let (s, c) = lp.theta.sin_cos();
             let (ox, oy) = f.origin();
             if let Ok(ddx) = std::env::var("DDX") {
                 let ddx: f64 = ddx.parse().unwrap();
-                let q = Xyt { x: truth.x + ddx * truth.t.cos(), y: truth.y + ddx * truth.t.sin(), ..truth };
+                let q = Xyt { x: truth.x + ddx * truth.theta.cos(), y: truth.y + ddx * truth.theta.sin(), ..truth };
                 let lq = matcher.laser_pose(&q);
                 let mut v = Vec::new();
                 for (i, b) in ps.matched.iter().enumerate() {
@@ -187,9 +187,9 @@ fn main() {
             for _ in 0..8 {
                 let (fa, fl) = (env_f("FIXA"), env_f("FIXL"));
                 let init = Xyt {
-                    x: truth.x + nl.sample(&mut rng) + fl * truth.t.cos(),
-                    y: truth.y + nl.sample(&mut rng) + fl * truth.t.sin(),
-                    t: truth.t + na.sample(&mut rng) + fa,
+                    x: truth.x + nl.sample(&mut rng) + fl * truth.theta.cos(),
+                    y: truth.y + nl.sample(&mut rng) + fl * truth.theta.sin(),
+                    theta: truth.theta + na.sample(&mut rng) + fa,
                 };
                 let r = matcher.match_scan(&tm, &init, &ps, None, &mut scratch);
                 let (p, s) = (r.pose, r.score);
@@ -203,10 +203,10 @@ fn main() {
                     worse += 1;
                 }
                 // error in the robot frame of the truth
-                let (c, s_) = (truth.t.cos(), truth.t.sin());
+                let (c, s_) = (truth.theta.cos(), truth.theta.sin());
                 let (dx, dy) = (p.x - truth.x, p.y - truth.y);
                 let (ex, ey) = (c * dx + s_ * dy, -s_ * dx + c * dy);
-                let et = p.t - truth.t;
+                let et = p.theta - truth.theta;
                 sx += ex;
                 sy += ey;
                 st += et;
@@ -224,27 +224,27 @@ fn main() {
                 (Some(e), Some(pt)) => {
                     let pt: Xyt = pt;
                     // true increment in the previous robot frame, drifted like the synthetic odometry
-                    let (c0, s0) = (pt.t.cos(), pt.t.sin());
+                    let (c0, s0) = (pt.theta.cos(), pt.theta.sin());
                     let (dx, dy) = (truth.x - pt.x, truth.y - pt.y);
                     let (ix, iy) = (c0 * dx + s0 * dy, -s0 * dx + c0 * dy);
                     let d = ix.hypot(iy);
-                    let (ix, iy, it) = (ix * 1.03, iy * 1.03, truth.t - pt.t + 0.01 * d);
+                    let (ix, iy, it) = (ix * 1.03, iy * 1.03, truth.theta - pt.theta + 0.01 * d);
                     let e: Xyt = e;
-                    let (c1, s1) = (e.t.cos(), e.t.sin());
-                    let init = Xyt { x: e.x + c1 * ix - s1 * iy, y: e.y + s1 * ix + c1 * iy, t: e.t + it };
+                    let (c1, s1) = (e.theta.cos(), e.theta.sin());
+                    let init = Xyt { x: e.x + c1 * ix - s1 * iy, y: e.y + s1 * ix + c1 * iy, theta: e.theta + it };
                     let r = matcher.match_scan(&tm, &init, &ps, None, &mut scratch);
-                    let (c, s_) = (truth.t.cos(), truth.t.sin());
+                    let (c, s_) = (truth.theta.cos(), truth.theta.sin());
                     let (ex, ey) = (r.pose.x - truth.x, r.pose.y - truth.y);
                     if k <= std::env::var("KMAX").ok().and_then(|v| v.parse().ok()).unwrap_or(usize::MAX) {
                         println!(
                             "k {k:4} ({:5.1},{:5.1}) init dθ {:+.5} -> matched along {:+.4} lateral {:+.4} dθ {:+.5} (step {:+.5})",
                             truth.x,
                             truth.y,
-                            init.t - truth.t,
+                            init.theta - truth.theta,
                             c * ex + s_ * ey,
                             -s_ * ex + c * ey,
-                            r.pose.t - truth.t,
-                            r.pose.t - init.t
+                            r.pose.theta - truth.theta,
+                            r.pose.theta - init.theta
                         );
                     }
                     r.pose
@@ -256,7 +256,7 @@ fn main() {
             map_pose = next;
         }
         let lp = matcher.laser_pose(&map_pose);
-        let (s, c) = lp.t.sin_cos();
+        let (s, c) = lp.theta.sin_cos();
         for b in &ps.hits {
             let (dx, dy) = (c * b.c - s * b.s, s * b.c + c * b.s);
             let (ex, ey) = (lp.x + b.r * dx, lp.y + b.r * dy);
@@ -284,9 +284,4 @@ fn main() {
 
 fn env_f(k: &str) -> f64 {
     std::env::var(k).ok().and_then(|v| v.parse().ok()).unwrap_or(0.0)
-}
-
-fn pose_to_xyt(p: &mrslam_core::Pose2) -> Xyt {
-    let (x, y, t) = pose_xyt(p);
-    Xyt { x, y, t }
 }

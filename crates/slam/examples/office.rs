@@ -8,6 +8,7 @@
 //! odometry), `ALL` (every particle's error and log-likelihood).
 #![allow(clippy::unwrap_used, reason = "a development aid / test: a failed unwrap names the problem")]
 
+use mrslam_core::Xyt;
 use mrslam_core::pose::relative;
 use mrslam_core::{CellState, OccupancyGrid, Pose2, pose};
 use mrslam_slam::synthetic::{self, Drift, Lidar, SyntheticRun};
@@ -135,8 +136,8 @@ fn main() {
             let k = run.truth.binary_search_by(|(s, _)| s.total_cmp(stamp)).unwrap();
             let t = relative(&t0, &run.truth[k].1);
             let e = t.inverse() * p;
-            let (ex, ey, et) = mrslam_core::pose::pose_xyt(&e);
-            let (tx, ty, _) = mrslam_core::pose::pose_xyt(&run.truth[k].1);
+            let Xyt { x: ex, y: ey, theta: et } = Xyt::from_pose(&e);
+            let Xyt { x: tx, y: ty, .. } = Xyt::from_pose(&run.truth[k].1);
             println!("{i:4} truth ({tx:5.1},{ty:5.1}) err ({ex:+.3},{ey:+.3},{et:+.4})");
         }
     }
@@ -153,16 +154,16 @@ fn main() {
             let dt = relative(&ta, &tb);
             let ds = relative(&traj[k - 1].1, &traj[k].1);
             let dodo = relative(&o_at(traj[k - 1].0), &o_at(traj[k].0));
-            let es = mrslam_core::pose::pose_xyt(&(dt.inverse() * ds));
-            let eo = mrslam_core::pose::pose_xyt(&(dt.inverse() * dodo));
+            let es = Xyt::from_pose(&(dt.inverse() * ds));
+            let eo = Xyt::from_pose(&(dt.inverse() * dodo));
             for (acc, e) in [(&mut sum_s, es), (&mut sum_o, eo)] {
-                acc[0] += e.0;
-                acc[1] += e.1;
-                acc[2] += e.2;
+                acc[0] += e.x;
+                acc[1] += e.y;
+                acc[2] += e.theta;
             }
-            let turn = mrslam_core::pose::pose_xyt(&dt).2.abs() > 1e-6;
+            let turn = Xyt::from_pose(&dt).theta.abs() > 1e-6;
             let next_turn = k + 1 < traj.len()
-                && mrslam_core::pose::pose_xyt(&relative(&t_at(traj[k].0), &t_at(traj[k + 1].0))).2.abs() > 1e-6;
+                && Xyt::from_pose(&relative(&t_at(traj[k].0), &t_at(traj[k + 1].0))).theta.abs() > 1e-6;
             if next_turn != turn || k + 1 == traj.len() {
                 println!(
                     "updates {leg_start:3}-{k:3} {}: slam sum err ({:+.4},{:+.4},{:+.5}) odo ({:+.4},{:+.4},{:+.5})",

@@ -14,8 +14,8 @@
 //! why the residual is not simply m − ĉ: there the prior holds the match at the sample. Particles contribute
 //! by weight; older information fades by exp(−distance / memory), so that κ can follow a change of floor.
 
-use crate::scan_matcher::Xyt;
-use mrslam_core::pose::{normalize_angle, pose_xyt};
+use mrslam_core::Xyt;
+use mrslam_core::pose::normalize_angle;
 use mrslam_core::{Pose2, pose};
 
 /// Prior standard deviation of each calibration parameter (distance scale error, heading drift in rad/m)
@@ -64,18 +64,17 @@ impl OdometryCalibration {
     }
 
     /// The calibrated increment of a raw one.
-    pub fn correct(&self, dx: f64, dy: f64, dt: f64) -> (f64, f64, f64) {
+    pub fn correct(&self, raw: Xyt) -> Xyt {
         let [a, b] = self.kappa;
-        ((1.0 + a) * dx, (1.0 + a) * dy, dt + b * dx)
+        Xyt { x: (1.0 + a) * raw.x, y: (1.0 + a) * raw.y, theta: raw.theta + b * raw.x }
     }
 
     /// Records a raw increment and its calibrated version.
-    pub fn record(&mut self, raw: (f64, f64, f64), corrected: (f64, f64, f64)) {
-        let compose =
-            |acc: Option<Pose2>, (x, y, t): (f64, f64, f64)| Some(acc.unwrap_or_else(Pose2::identity) * pose(x, y, t));
+    pub fn record(&mut self, raw: Xyt, corrected: Xyt) {
+        let compose = |acc: Option<Pose2>, d: Xyt| Some(acc.unwrap_or_else(Pose2::identity) * d.to_pose());
         self.raw = compose(self.raw, raw);
         self.corrected = compose(self.corrected, corrected);
-        self.forward += raw.0;
+        self.forward += raw.x;
     }
 
     /// Forgets the increments (after a processed scan).
@@ -89,22 +88,22 @@ impl OdometryCalibration {
     /// does not depend on threads); what it knew fades over `memory` metres driven.
     pub fn update(&mut self, matches: impl Iterator<Item = CalibrationMatch>, memory: f64) {
         let (Some(raw), Some(corrected)) = (self.raw, self.corrected) else { return };
-        let (rx, ry, _) = pose_xyt(&raw);
+        let Xyt { x: rx, y: ry, .. } = Xyt::from_pose(&raw);
         let forward = self.forward;
         let dot = |u: &[f64; 3], v: &[f64; 3]| u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
-        let diff = |p: &Xyt, q: &Xyt| [p.x - q.x, p.y - q.y, normalize_angle(p.t - q.t)];
+        let diff = |p: &Xyt, q: &Xyt| [p.x - q.x, p.y - q.y, normalize_angle(p.theta - q.theta)];
         let (mut a, mut g) = ([0.0f64; 3], [0.0f64; 2]);
         for CalibrationMatch { matched, start, previous: prev, scan: hs, prior: hp, weight: w } in matches {
             // the calibrated odometry's prediction from the previous pose
-            let (cx, cy, ct) = pose_xyt(&(pose(prev.x, prev.y, prev.t) * corrected));
-            let c = Xyt { x: cx, y: cy, t: ct };
+            let Xyt { x: cx, y: cy, theta: ct } = Xyt::from_pose(&(pose(prev.x, prev.y, prev.theta) * corrected));
+            let c = Xyt { x: cx, y: cy, theta: ct };
             // H_s (z - c) = (H_s + H_prior) (m - s) + H_s (s - c)
             let mut ht = hs;
             add_sym(&mut ht, &hp, 1.0);
             let (r1, r2) = (sym_mul(&ht, &diff(&matched, &start)), sym_mul(&hs, &diff(&start, &c)));
             let r = [r1[0] + r2[0], r1[1] + r2[1], r1[2] + r2[2]];
             // J's columns, d(increment)/d(a, b), in the map frame
-            let (s, co) = prev.t.sin_cos();
+            let (s, co) = prev.theta.sin_cos();
             let cols = [[co * rx - s * ry, s * rx + co * ry, 0.0], [0.0, 0.0, forward]];
             let hcols = [sym_mul(&hs, &cols[0]), sym_mul(&hs, &cols[1])];
             a[0] += w * dot(&cols[0], &hcols[0]);
@@ -152,12 +151,13 @@ mod tests {
     #[test]
     fn corrects_increments_and_composes_what_it_saw() {
         let mut c = OdometryCalibration { kappa: [-0.1, 0.02], ..Default::default() };
-        let (dx, dy, dt) = c.correct(1.0, 0.5, 0.1);
+        let Xyt { x: dx, y: dy, theta: dt } = c.correct(Xyt { x: 1.0, y: 0.5, theta: 0.1 });
         assert!((dx - 0.9).abs() < 1e-12 && (dy - 0.45).abs() < 1e-12 && (dt - 0.12).abs() < 1e-12);
-        c.record((1.0, 0.0, 0.0), c.correct(1.0, 0.0, 0.0));
-        c.record((1.0, 0.0, 0.0), c.correct(1.0, 0.0, 0.0));
+        let forward = Xyt { x: 1.0, y: 0.0, theta: 0.0 };
+        c.record(forward, c.correct(forward));
+        c.record(forward, c.correct(forward));
         assert!((c.forward - 2.0).abs() < 1e-12);
-        assert!((pose_xyt(&c.raw.unwrap()).0 - 2.0).abs() < 1e-12);
+        assert!((Xyt::from_pose(&c.raw.unwrap()).x - 2.0).abs() < 1e-12);
         c.reset_increments();
         assert!(c.raw.is_none() && c.corrected.is_none() && c.forward == 0.0);
         // Nothing recorded: an update learns nothing.

@@ -103,11 +103,7 @@ pub fn poses_at_every_scan(stamps: &[f64], odometry: &[Pose2], processed: &[(usi
 #[cfg(test)]
 mod tests {
     use super::*;
-    use mrslam_core::pose::{pose, pose_xyt};
-
-    fn xyt(p: &Pose2) -> (f64, f64, f64) {
-        pose_xyt(p)
-    }
+    use mrslam_core::pose::{Xyt, pose};
 
     #[test]
     fn processed_scans_keep_their_poses_and_the_correction_is_spread_between_them() {
@@ -120,11 +116,11 @@ mod tests {
         assert_eq!(poses[0], processed[0].1);
         assert_eq!(poses[4], processed[1].1);
         for (i, p) in poses.iter().enumerate().take(4) {
-            let (x, y, t) = xyt(p);
+            let Xyt { x, y, theta: t } = Xyt::from_pose(p);
             assert!((x - i as f64).abs() < 1e-12 && (y - 0.1 * i as f64).abs() < 1e-12 && t.abs() < 1e-12);
         }
         // After the last processed scan: odometry from it.
-        let (x, y, _) = xyt(&poses[6]);
+        let Xyt { x, y, .. } = Xyt::from_pose(&poses[6]);
         assert!((x - 6.0).abs() < 1e-12 && (y - 0.4).abs() < 1e-12);
     }
 
@@ -134,7 +130,7 @@ mod tests {
         let odometry = [pose(0.0, 0.0, 0.0), pose(1.0, 0.0, 0.0), pose(1.0, 0.0, std::f64::consts::FRAC_PI_2)];
         // The filter's frame starts at scan 2 facing +x.
         let poses = poses_at_every_scan(&stamps, &odometry, &[(2, pose(0.0, 0.0, 0.0))]).unwrap();
-        let (x, y, t) = xyt(&poses[0]);
+        let Xyt { x, y, theta: t } = Xyt::from_pose(&poses[0]);
         assert!((x - 0.0).abs() < 1e-12 && (y - 1.0).abs() < 1e-12 && (t + std::f64::consts::FRAC_PI_2).abs() < 1e-12);
     }
 

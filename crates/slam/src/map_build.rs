@@ -12,7 +12,7 @@
 
 use crate::params::SlamParams;
 use crate::particle::TrajectoryNode;
-use crate::scan_matcher::Xyt;
+use mrslam_core::Xyt;
 use mrslam_core::grid::MAX_CELLS;
 use mrslam_core::map_io::ROS_LOGODDS_LIMIT;
 use mrslam_core::{CellTraversal, LaserScan, OccupancyGrid, pose};
@@ -32,8 +32,8 @@ fn beam_end(scan: &LaserScan, i: usize, params: &SlamParams) -> Option<(f64, boo
 
 /// Sensor pose (x, y, θ) for a robot pose.
 fn sensor(p: &Xyt, laser: &Xyt) -> Xyt {
-    let (s, c) = p.t.sin_cos();
-    Xyt { x: p.x + c * laser.x - s * laser.y, y: p.y + s * laser.x + c * laser.y, t: p.t + laser.t }
+    let (s, c) = p.theta.sin_cos();
+    Xyt { x: p.x + c * laser.x - s * laser.y, y: p.y + s * laser.x + c * laser.y, theta: p.theta + laser.theta }
 }
 
 /// Builds the map of a trajectory (nodes in any order; order does not change the counts).
@@ -56,7 +56,7 @@ pub fn build_map(nodes: &[&TrajectoryNode], laser: &Xyt, params: &SlamParams) ->
         grow(lp.x, lp.y);
         for i in 0..n.scan.len() {
             if let Some((r, _)) = beam_end(&n.scan, i, params) {
-                let a = lp.t + n.scan.angle(i);
+                let a = lp.theta + n.scan.angle(i);
                 grow(lp.x + r * a.cos(), lp.y + r * a.sin());
             }
         }
@@ -80,7 +80,7 @@ pub fn build_map(nodes: &[&TrajectoryNode], laser: &Xyt, params: &SlamParams) ->
                 let Some((r, true)) = beam_end(&n.scan, i, params) else {
                     continue;
                 };
-                let a = lp.t + n.scan.angle(i);
+                let a = lp.theta + n.scan.angle(i);
                 let (cx, cy) = ((sx + r * a.cos() * inv).floor() as i64, (sy + r * a.sin() * inv).floor() as i64);
                 if cx >= 0 && cy >= 0 && (cx as usize) < w && (cy as usize) < h {
                     let k = cy as usize * w + cx as usize;
@@ -97,7 +97,7 @@ pub fn build_map(nodes: &[&TrajectoryNode], laser: &Xyt, params: &SlamParams) ->
             let Some((r, hit)) = beam_end(&n.scan, i, params) else {
                 continue;
             };
-            let a = lp.t + n.scan.angle(i);
+            let a = lp.theta + n.scan.angle(i);
             let (ex, ey) = (sx + r * a.cos() * inv, sy + r * a.sin() * inv);
             let trav = CellTraversal::new(sx, sy, ex, ey);
             let end = trav.end_cell();
@@ -161,13 +161,13 @@ mod tests {
         let nodes: Vec<TrajectoryNode> = (0..10)
             .map(|k| TrajectoryNode {
                 stamp: k as f64,
-                pose: Xyt { x: 0.0, y: 0.0, t: 0.0 },
+                pose: Xyt { x: 0.0, y: 0.0, theta: 0.0 },
                 scan: Arc::new(scan(k == 9)),
                 parent: None,
             })
             .collect();
         let refs: Vec<&TrajectoryNode> = nodes.iter().collect();
-        let laser = Xyt { x: 0.0, y: 0.0, t: 0.0 };
+        let laser = Xyt { x: 0.0, y: 0.0, theta: 0.0 };
         let state_at = |params: &SlamParams, x: f64| {
             let map = build_map(&refs, &laser, params).unwrap();
             let p = nalgebra::Point2::new(x, 0.0);

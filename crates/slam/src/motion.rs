@@ -1,6 +1,6 @@
 //! The odometry motion model: GMapping's `MotionModel::drawFromMotion`.
 
-use mrslam_core::pose::{Pose2, normalize_angle, pose, pose_xyt, relative};
+use mrslam_core::pose::{Pose2, Xyt, normalize_angle, pose, relative};
 use rand::Rng;
 use rand_distr::StandardNormal;
 
@@ -33,7 +33,7 @@ impl MotionModel {
     /// `x += N(srr|dx| + str|dθ| + 0.3·srr|dy|)`, `y += N(srr|dy| + str|dθ| + 0.3·srr|dx|)`,
     /// `θ += N(stt|dθ| + srt·|(dx, dy)|)` (standard deviations), and is composed onto `p`.
     pub fn draw_from_motion<R: Rng>(&self, rng: &mut R, p: &Pose2, new: &Pose2, old: &Pose2) -> Pose2 {
-        let (dx, dy, dt) = pose_xyt(&relative(old, new));
+        let Xyt { x: dx, y: dy, theta: dt } = Xyt::from_pose(&relative(old, new));
         self.draw_increment(rng, p, dx, dy, dt)
     }
 
@@ -86,7 +86,7 @@ mod tests {
                 &pose(2.0, 1.0 + 1.0, std::f64::consts::FRAC_PI_2),
                 &pose(2.0, 1.0, std::f64::consts::FRAC_PI_2),
             );
-            let (x, _, t) = pose_xyt(&q);
+            let Xyt { x, theta: t, .. } = Xyt::from_pose(&q);
             sx += x;
             sxx += x * x;
             st += t * t;

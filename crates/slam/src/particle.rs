@@ -1,8 +1,8 @@
 //! A particle: pose, weights, its own map, and its trajectory as a tree of shared nodes (GMapping's `TNode`).
 
-use crate::scan_matcher::Xyt;
 use crate::tile_map::TileMap;
 use mrslam_core::LaserScan;
+use mrslam_core::Xyt;
 use std::sync::Arc;
 
 /// One processed scan of a particle's trajectory. Nodes are shared between particles descending from a
@@ -61,7 +61,7 @@ impl Particle {
     /// A particle at the origin with an empty map.
     pub fn new(delta: f64) -> Self {
         Particle {
-            pose: Xyt { x: 0.0, y: 0.0, t: 0.0 },
+            pose: Xyt { x: 0.0, y: 0.0, theta: 0.0 },
             weight: 0.0,
             weight_sum: 0.0,
             map: TileMap::new(delta),
@@ -88,7 +88,7 @@ mod tests {
         for i in 0..1_000_000 {
             node = Some(Arc::new(TrajectoryNode {
                 stamp: i as f64,
-                pose: Xyt { x: 0.0, y: 0.0, t: 0.0 },
+                pose: Xyt { x: 0.0, y: 0.0, theta: 0.0 },
                 scan: scan.clone(),
                 parent: node,
             }));

@@ -7,9 +7,9 @@ use crate::motion::MotionModel;
 use crate::params::SlamParams;
 use crate::particle::{Particle, TrajectoryNode, ancestry};
 use crate::resample::{normalize, systematic};
-use crate::scan_matcher::{MatchResult, MotionPrior, PreparedScan, ScanMatcher, Scratch, Xyt};
+use crate::scan_matcher::{MatchResult, MotionPrior, PreparedScan, ScanMatcher, Scratch};
 use crate::scan_odometry::ScanOdometry;
-use mrslam_core::pose::{pose_xyt, relative};
+use mrslam_core::pose::{Xyt, relative};
 use mrslam_core::{LaserScan, OccupancyGrid, Odometry, Pose2};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -170,7 +170,7 @@ impl Rbpf {
     pub fn new(params: SlamParams, laser_offset: Pose2, seed: u64) -> Result<Self, SlamError> {
         params.validate().map_err(SlamError::BadParams)?;
         let laser = Xyt::from_pose(&laser_offset);
-        if !(laser.x.is_finite() && laser.y.is_finite() && laser.t.is_finite()) {
+        if !(laser.x.is_finite() && laser.y.is_finite() && laser.theta.is_finite()) {
             return Err(SlamError::BadLaserOffset);
         }
         let matcher = ScanMatcher::from_params(&params, laser);
@@ -249,9 +249,9 @@ impl Rbpf {
             return self.update(odom, scan, true);
         };
 
-        let raw = pose_xyt(&relative(&odo_pose, &odom.pose));
-        let (dx, dy, dt) = if self.params.odometry_calibration > 0.0 {
-            let corrected = self.calibration.correct(raw.0, raw.1, raw.2);
+        let raw = Xyt::from_pose(&relative(&odo_pose, &odom.pose));
+        let Xyt { x: dx, y: dy, theta: dt } = if self.params.odometry_calibration > 0.0 {
+            let corrected = self.calibration.correct(raw);
             self.calibration.record(raw, corrected);
             corrected
         } else {
@@ -261,8 +261,8 @@ impl Rbpf {
             let moved = self.motion.draw_increment(&mut self.rng, &p.pose.to_pose(), dx, dy, dt);
             p.pose = Xyt::from_pose(&moved);
         }
-        self.linear_distance += raw.0.hypot(raw.1);
-        self.angular_distance += raw.2.abs();
+        self.linear_distance += raw.x.hypot(raw.y);
+        self.angular_distance += raw.theta.abs();
         let [sx, sy, st] = self.motion.sigmas(dx, dy, dt);
         self.motion_var[0] += sx * sx;
         self.motion_var[1] += sy * sy;
@@ -288,7 +288,7 @@ impl Rbpf {
 
     /// Checks a reading before anything changes.
     fn validate(&self, odom: &Odometry, scan: &LaserScan) -> Result<(), SlamError> {
-        let (x, y, t) = pose_xyt(&odom.pose);
+        let Xyt { x, y, theta: t } = Xyt::from_pose(&odom.pose);
         let bad_odom = |message: String| SlamError::BadOdometry { stamp: odom.stamp, message };
         if !odom.stamp.is_finite() {
             return Err(bad_odom("stamp is not finite".into()));
@@ -421,7 +421,7 @@ impl Rbpf {
         let banded = &banded;
         let mapped: Result<(), SlamError> = self.particles.par_iter_mut().try_for_each(|part| {
             let lp = matcher.laser_pose(&part.pose);
-            let (s, c) = lp.t.sin_cos();
+            let (s, c) = lp.theta.sin_cos();
             let too_large = |part: &Particle| {
                 SlamError::MapTooLarge(format!(
                     "a particle at ({:.1}, {:.1}) m left the largest map supported",

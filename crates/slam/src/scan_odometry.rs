@@ -21,9 +21,9 @@
 
 use crate::motion::MotionModel;
 use crate::params::{MatcherKind, SlamParams};
-use crate::scan_matcher::{MotionPrior, PreparedScan, ScanMatcher, Scratch, Xyt};
+use crate::scan_matcher::{MotionPrior, PreparedScan, ScanMatcher, Scratch};
 use crate::tile_map::TileMap;
-use mrslam_core::pose::{pose, pose_xyt, relative};
+use mrslam_core::pose::{Xyt, pose, relative};
 use mrslam_core::{LaserScan, Pose2};
 
 /// Smallest standard deviations (x, y metres; heading radians) of the prior on an increment: a robot
@@ -95,7 +95,7 @@ impl ScanOdometry {
             submap_scans: params.scan_odometry_submap.max(1),
             submaps: [(TileMap::new(params.delta), 0), (TileMap::new(params.delta), 0)],
             last_raw: None,
-            pose: Xyt { x: 0.0, y: 0.0, t: 0.0 },
+            pose: Xyt { x: 0.0, y: 0.0, theta: 0.0 },
             noise: MotionModel { srr: params.srr, srt: params.srt, str: params.str, stt: params.stt },
             scratch: Scratch::default(),
             inserted: 0,
@@ -114,7 +114,7 @@ impl ScanOdometry {
                 OdometryStep::First
             }
             Some(last) => {
-                let (dx, dy, dt) = pose_xyt(&relative(&last, raw));
+                let Xyt { x: dx, y: dy, theta: dt } = Xyt::from_pose(&relative(&last, raw));
                 let predicted = Xyt::from_pose(&(self.pose.to_pose() * pose(dx, dy, dt)));
                 let [sx, sy, st] = self.noise.sigmas(dx, dy, dt);
                 let prior = MotionPrior {
@@ -154,7 +154,7 @@ impl ScanOdometry {
             self.submaps[1] = (TileMap::new(self.delta), 0);
         }
         let lp = self.matcher.laser_pose(&self.pose);
-        let (s, c) = lp.t.sin_cos();
+        let (s, c) = lp.theta.sin_cos();
         for (map, count) in self.submaps.iter_mut().take(if i >= n { 2 } else { 1 }) {
             for b in &prepared.hits {
                 let (dx, dy) = (c * b.c - s * b.s, s * b.c + c * b.s);
@@ -181,7 +181,7 @@ mod tests {
     /// (translation m, rotation rad) of the error of the end pose relative to the start pose.
     fn end_error(est: &[Pose2], truth: &[Pose2]) -> (f64, f64) {
         let e = relative(&relative(&est[0], &est[est.len() - 1]), &relative(&truth[0], &truth[truth.len() - 1]));
-        let (x, y, t) = pose_xyt(&e);
+        let Xyt { x, y, theta: t } = Xyt::from_pose(&e);
         (x.hypot(y), normalize_angle(t).abs())
     }
 
@@ -196,7 +196,7 @@ mod tests {
         // first corner, the odometry's heading lags the truth by 0.03 rad per scan for 30 scans.
         let turn = (1..path.len())
             .find(|&i| {
-                let (dx, dy, dt) = pose_xyt(&relative(&path[i - 1], &path[i]));
+                let Xyt { x: dx, y: dy, theta: dt } = Xyt::from_pose(&relative(&path[i - 1], &path[i]));
                 dt.abs() > 0.01 && dx.hypot(dy) < 1e-6
             })
             .expect("the path turns");
@@ -208,7 +208,7 @@ mod tests {
             run.odometry[i].pose *= wrong;
         }
         let params = SlamParams { scan_odometry: true, ..SlamParams::default() };
-        let mut so = ScanOdometry::new(&params, Xyt { x: 0.1, y: 0.0, t: 0.0 });
+        let mut so = ScanOdometry::new(&params, Xyt { x: 0.1, y: 0.0, theta: 0.0 });
         let mut corrected = Vec::new();
         let mut steps = Vec::new();
         for (o, s) in run.odometry.iter().zip(&run.scans) {
@@ -229,7 +229,7 @@ mod tests {
         // Every increment, not just the end: no step is off by more than 2 cm or 0.5°.
         for i in 1..path.len() {
             let e = relative(&relative(&corrected[i - 1], &corrected[i]), &relative(&path[i - 1], &path[i]));
-            let (x, y, th) = pose_xyt(&e);
+            let Xyt { x, y, theta: th } = Xyt::from_pose(&e);
             assert!(x.hypot(y) < 0.02 && th.abs() < 0.5f64.to_radians(), "step {i}: {x} {y} {th}");
         }
     }

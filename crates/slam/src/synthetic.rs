@@ -3,7 +3,7 @@
 //!
 //! Nothing here knows about the simulator crate: it uses core's grid ray casting only.
 
-use mrslam_core::pose::{normalize_angle, pose_xyt, relative};
+use mrslam_core::pose::{Xyt, normalize_angle, relative};
 use mrslam_core::{LaserScan, OccupancyGrid, Odometry, Pose2, pose};
 use nalgebra::Point2;
 use rand::{Rng, SeedableRng};
@@ -83,7 +83,7 @@ impl Lidar {
 
     /// A scan from `sensor` (map frame) on `map`, with Gaussian range noise (and dropouts) from `rng`.
     pub fn scan<R: Rng>(&self, map: &OccupancyGrid, sensor: &Pose2, stamp: f64, rng: &mut R) -> LaserScan {
-        let (x, y, t) = pose_xyt(sensor);
+        let Xyt { x, y, theta: t } = Xyt::from_pose(sensor);
         let inc = self.increment();
         let angle_min = -self.fov / 2.0;
         let from = Point2::new(x, y);
@@ -154,7 +154,7 @@ pub fn inject_drift(odometry: &mut [Odometry], drift: &Drift, seed: u64) {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let (mut prev_raw, mut cur) = (first, first);
     for o in odometry.iter_mut() {
-        let (dx, dy, dt) = pose_xyt(&relative(&prev_raw, &o.pose));
+        let Xyt { x: dx, y: dy, theta: dt } = Xyt::from_pose(&relative(&prev_raw, &o.pose));
         prev_raw = o.pose;
         cur *= drift.apply(&mut rng, dx, dy, dt);
         o.pose = cur;
@@ -198,7 +198,7 @@ pub fn simulate(
     for (i, p) in path.iter().enumerate() {
         let stamp = i as f64 * dt;
         if i > 0 {
-            let (dx, dy, dth) = pose_xyt(&relative(&path[i - 1], p));
+            let Xyt { x: dx, y: dy, theta: dth } = Xyt::from_pose(&relative(&path[i - 1], p));
             odo *= drift.apply(&mut rng, dx, dy, dth);
         }
         out.truth.push((stamp, *p));

@@ -1,7 +1,7 @@
 //! End-to-end: the filter on synthetic data with a known map, path and drifting odometry.
 #![allow(clippy::unwrap_used, reason = "a development aid / test: a failed unwrap names the problem")]
 
-use mrslam_core::pose::{pose_xyt, relative};
+use mrslam_core::pose::{Xyt, relative};
 use mrslam_core::{CellState, OccupancyGrid, Odometry, Pose2, pose};
 use mrslam_slam::synthetic::{self, Drift, Lidar, SyntheticRun};
 use mrslam_slam::{Rbpf, SlamParams, UpdateOutcome};
@@ -165,7 +165,7 @@ fn same_seed_same_trajectory_bit_for_bit() {
         f.trajectory()
             .iter()
             .map(|(s, p)| {
-                let (x, y, t) = pose_xyt(p);
+                let Xyt { x, y, theta: t } = Xyt::from_pose(p);
                 (s.to_bits(), x.to_bits(), y.to_bits(), t.to_bits())
             })
             .collect()
@@ -179,8 +179,8 @@ fn same_seed_same_trajectory_bit_for_bit() {
     assert_eq!(wa, wb);
     let c = run_filter(&run, SlamParams::hokuyo(), 43);
     assert_ne!(
-        a.particles().map(|(p, _)| pose_xyt(&p).0.to_bits()).collect::<Vec<_>>(),
-        c.particles().map(|(p, _)| pose_xyt(&p).0.to_bits()).collect::<Vec<_>>(),
+        a.particles().map(|(p, _)| Xyt::from_pose(&p).x.to_bits()).collect::<Vec<_>>(),
+        c.particles().map(|(p, _)| Xyt::from_pose(&p).x.to_bits()).collect::<Vec<_>>(),
         "another seed draws other particles"
     );
 }
@@ -286,7 +286,7 @@ fn results_do_not_depend_on_the_number_of_threads() {
         let poses: Vec<(u64, u64, u64)> = f
             .particles()
             .map(|(p, w)| {
-                let (x, _, t) = pose_xyt(&p);
+                let Xyt { x, theta: t, .. } = Xyt::from_pose(&p);
                 (x.to_bits(), t.to_bits(), w.to_bits())
             })
             .collect();

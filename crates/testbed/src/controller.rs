@@ -1,6 +1,6 @@
 //! Controllers: pure pursuit along waypoints, and frontier exploration on the robot's own map.
 
-use mrslam_core::{CellState, LaserScan, OccupancyGrid, Pose2, pose_xyt};
+use mrslam_core::{CellState, LaserScan, OccupancyGrid, Pose2, Xyt};
 use nalgebra::Point2;
 use std::collections::VecDeque;
 
@@ -93,7 +93,7 @@ impl PurePursuit {
             self.v = 0.0;
             return (0.0, 0.0);
         }
-        let (x, y, _) = pose_xyt(pose);
+        let Xyt { x, y, .. } = Xyt::from_pose(pose);
         let p = Point2::new(x, y);
         let goal = *self.path.last().expect("non-empty path");
         let to_goal = (goal - p).norm();
@@ -333,13 +333,13 @@ mod tests {
         let mut t = 0.0;
         while !pp.is_done() && t < 60.0 {
             let (v, w) = pp.command(&p, dt);
-            let (x, y, th) = pose_xyt(&p);
+            let Xyt { x, y, theta: th } = Xyt::from_pose(&p);
             p = pose(x + v * th.cos() * dt, y + v * th.sin() * dt, th + w * dt);
             t += dt;
             assert!(x > -0.3 && x < 2.3 && y > -0.3 && y < 2.3, "left the route at ({x}, {y})");
         }
         assert!(pp.is_done(), "did not arrive in 60 s");
-        let (x, y, _) = pose_xyt(&p);
+        let Xyt { x, y, .. } = Xyt::from_pose(&p);
         assert!(x.hypot(y - 2.0) < 0.1);
     }
 

@@ -1,6 +1,6 @@
 //! The run report (`report.json`) and its human summary.
 
-use mrslam_merge::TransformXyt;
+use mrslam_core::Xyt;
 use std::collections::BTreeMap;
 
 /// Per-robot results.
@@ -67,11 +67,11 @@ pub struct MergeResult {
     /// Why it was rejected.
     pub reason: Option<String>,
     /// Estimated transform (host ← other).
-    pub transform: Option<TransformXyt>,
+    pub transform: Option<Xyt>,
     /// True transform (host ← other).
-    pub true_transform: TransformXyt,
+    pub true_transform: Xyt,
     /// The maps' relative transform as the robots' last poses place them (host ← other).
-    pub true_transform_at_end: TransformXyt,
+    pub true_transform_at_end: Xyt,
     /// Inliers and matches of the algorithm.
     pub inliers: usize,
     /// Tentative matches.

@@ -5,10 +5,10 @@ use crate::eval::{map_acceptance, rmse, transform_error};
 use crate::report::{MergeResult, RobotReport, RunReport};
 use crate::scenario::{ControllerKind, MergeWhen, RobotSetup, Scenario};
 use mrslam_core::map_io::{self, MapIoError};
-use mrslam_core::{CellTraversal, LaserScan, OccupancyGrid, Odometry, Pose2};
+use mrslam_core::{CellTraversal, LaserScan, OccupancyGrid, Odometry, Pose2, Xyt};
 use mrslam_merge::{
     Algorithm, CorrelativeMerger, MatchParams, MergeOutcome, MergeParams, Merger, RmapMerger, RmapParams, SiftMerger,
-    SiftMergerParams, TransformXyt, merge,
+    SiftMergerParams, merge,
 };
 use mrslam_sim::geometry::Obstacle;
 use mrslam_sim::{RobotId, Sim, SimConfig, SimError, StepEvents};
@@ -370,8 +370,8 @@ pub fn run(scenario: &Scenario, mut opts: RunOptions) -> Result<RunOutput, RunEr
             time_ms: out.report.time_ms,
             reason: out.report.reason.clone(),
             transform: out.report.transform,
-            true_transform: TransformXyt::from_pose(&true_t),
-            true_transform_at_end: TransformXyt::from_pose(&end_t),
+            true_transform: Xyt::from_pose(&true_t),
+            true_transform_at_end: Xyt::from_pose(&end_t),
             inliers: out.report.inliers,
             matches: out.report.matches,
         });

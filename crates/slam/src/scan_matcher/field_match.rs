@@ -15,7 +15,7 @@ impl ScanMatcher {
     /// Builds `field` for `map` around the end points of `scan` at robot pose `p`.
     pub fn build_field(&self, map: &TileMap, p: &Xyt, scan: &PreparedScan, field: &mut Field) {
         let lp = self.laser_pose(p);
-        let (s, c) = lp.t.sin_cos();
+        let (s, c) = lp.theta.sin_cos();
         let (mut x0, mut y0, mut x1, mut y1) = (lp.x, lp.y, lp.x, lp.y);
         for b in scan.hits.iter().chain(&scan.matched) {
             let (px, py) = (lp.x + c * b.x - s * b.y, lp.y + s * b.x + c * b.y);
@@ -48,7 +48,7 @@ impl ScanMatcher {
     #[inline]
     pub fn field_eval(&self, f: &Field, p: &Xyt, beams: &[Beam]) -> Evaluation {
         let lp = self.laser_pose(p);
-        let (s, c) = lp.t.sin_cos();
+        let (s, c) = lp.theta.sin_cos();
         let (ox, oy) = f.origin();
         let (lx, ly) = (lp.x - ox, lp.y - oy);
         let inv_sigma = 1.0 / self.sigma;
@@ -91,7 +91,7 @@ impl ScanMatcher {
             let Some(d) = solve3(&h, &g) else { break };
             p.x -= d[0];
             p.y -= d[1];
-            p.t -= d[2];
+            p.theta -= d[2];
             if d[0].abs() + d[1].abs() < REFINE_TOLERANCE && d[2].abs() < REFINE_TOLERANCE {
                 break;
             }
@@ -114,7 +114,7 @@ impl ScanMatcher {
         // residuals in metres with the kernel's variance sigma/2: weights w·2/sigma in chi-square units
         let scale = 2.0 * inv_sigma;
         let lp = self.laser_pose(p);
-        let (s, c) = lp.t.sin_cos();
+        let (s, c) = lp.theta.sin_cos();
         let (lx, ly) = (lp.x - ox, lp.y - oy);
         let (rx, ry) = (p.x - ox, p.y - oy);
         let mut h = [0.0f64; 6]; // upper triangle of the 3x3 normal matrix: 00 01 02 11 12 22

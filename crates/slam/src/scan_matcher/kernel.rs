@@ -69,7 +69,7 @@ impl ScanMatcher {
     /// GMapping's `score`: sum over beams of exp(-d²/sigma) at robot pose `p`.
     pub fn score(&self, map: &TileMap, p: &Xyt, beams: &[Beam]) -> f64 {
         let lp = self.laser_pose(p);
-        let (s, c) = lp.t.sin_cos();
+        let (s, c) = lp.theta.sin_cos();
         let inv_sigma = 1.0 / self.sigma;
         let mut total = 0.0;
         for b in beams {
@@ -91,7 +91,7 @@ impl ScanMatcher {
     /// GMapping's `likelihoodAndScore` at robot pose `p`.
     pub fn likelihood_and_score(&self, map: &TileMap, p: &Xyt, beams: &[Beam]) -> Evaluation {
         let lp = self.laser_pose(p);
-        let (s, c) = lp.t.sin_cos();
+        let (s, c) = lp.theta.sin_cos();
         let no_hit = NULL_LIKELIHOOD / self.lsigma;
         let mut e = Evaluation::default();
         for b in beams {
@@ -126,7 +126,7 @@ impl ScanMatcher {
     /// map. Chosen once at the start pose of the climb, the set cannot be gamed by moving.
     pub fn beams_in_map(&self, map: &TileMap, p: &Xyt, beams: &[Beam]) -> Vec<Beam> {
         let lp = self.laser_pose(p);
-        let (s, c) = lp.t.sin_cos();
+        let (s, c) = lp.theta.sin_cos();
         beams
             .iter()
             .filter(|b| {

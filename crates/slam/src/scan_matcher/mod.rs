@@ -26,34 +26,10 @@ mod kernel;
 use crate::field::Field;
 use crate::params::SlamParams;
 use crate::tile_map::TileMap;
-use mrslam_core::LaserScan;
+use mrslam_core::{LaserScan, Xyt};
 
 /// GMapping's `nullLikelihood`: a beam that matches nothing costs `-0.5/lsigma`.
 const NULL_LIKELIHOOD: f64 = -0.5;
-
-/// A pose as (x, y, θ), metres and radians: the matcher's working form.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Xyt {
-    /// x, metres.
-    pub x: f64,
-    /// y, metres.
-    pub y: f64,
-    /// Heading, radians.
-    pub t: f64,
-}
-
-impl Xyt {
-    /// The (x, y, θ) of a pose.
-    pub fn from_pose(p: &mrslam_core::Pose2) -> Self {
-        let (x, y, t) = mrslam_core::pose::pose_xyt(p);
-        Xyt { x, y, t }
-    }
-
-    /// The pose of (x, y, θ).
-    pub fn to_pose(&self) -> mrslam_core::Pose2 {
-        mrslam_core::pose(self.x, self.y, self.t)
-    }
-}
 
 /// The `field` matcher's heading search scores every this-many-th matched beam.
 const SWEEP_STRIDE: usize = 4;
@@ -251,7 +227,7 @@ impl PosePrior {
 
     #[inline]
     fn delta(&self, q: &Xyt) -> [f64; 3] {
-        [q.x - self.centre.x, q.y - self.centre.y, mrslam_core::pose::normalize_angle(q.t - self.centre.t)]
+        [q.x - self.centre.x, q.y - self.centre.y, mrslam_core::pose::normalize_angle(q.theta - self.centre.theta)]
     }
 }
 
@@ -369,7 +345,7 @@ impl ScanMatcher {
                 let f = &scratch.field;
                 let prior = prior
                     .filter(|_| self.motion_prior > 0.0)
-                    .map(|m| PosePrior { info: m.information(init.t, self.motion_prior), centre: *init });
+                    .map(|m| PosePrior { info: m.information(init.theta, self.motion_prior), centre: *init });
                 let penalty = |q: &Xyt| prior.as_ref().map_or(0.0, |p| p.penalty(q));
                 let objective = |q: &Xyt| self.field_eval(f, q, &scan.matched).score - penalty(q);
                 // The heading search and the climb only pick the basin and approach its optimum, which the
@@ -405,11 +381,11 @@ impl ScanMatcher {
     /// The laser's pose in the map frame for robot pose `p`.
     #[inline]
     pub fn laser_pose(&self, p: &Xyt) -> Xyt {
-        let (s, c) = p.t.sin_cos();
+        let (s, c) = p.theta.sin_cos();
         Xyt {
             x: p.x + c * self.laser.x - s * self.laser.y,
             y: p.y + s * self.laser.x + c * self.laser.y,
-            t: p.t + self.laser.t,
+            theta: p.theta + self.laser.theta,
         }
     }
 
@@ -423,7 +399,7 @@ impl ScanMatcher {
         let mut best = (score(init), *init);
         for i in 1..=k {
             for sign in [-1.0, 1.0] {
-                let q = Xyt { t: init.t + sign * i as f64 * self.heading_step, ..*init };
+                let q = Xyt { theta: init.theta + sign * i as f64 * self.heading_step, ..*init };
                 let s = score(&q);
                 if s > best.0 {
                     best = (s, q);
@@ -459,8 +435,8 @@ impl ScanMatcher {
                     1 => q.x -= ldelta,
                     2 => q.y -= ldelta,
                     3 => q.y += ldelta,
-                    4 => q.t += adelta,
-                    _ => q.t -= adelta,
+                    4 => q.theta += adelta,
+                    _ => q.theta -= adelta,
                 }
                 let s = score(&q);
                 if s > current_score {
@@ -484,7 +460,7 @@ mod tests {
 
     fn matcher() -> ScanMatcher {
         ScanMatcher {
-            laser: Xyt { x: 0.0, y: 0.0, t: 0.0 },
+            laser: Xyt { x: 0.0, y: 0.0, theta: 0.0 },
             sigma: 0.05,
             lsigma: 0.075,
             kernel_size: 1,
@@ -546,13 +522,13 @@ mod tests {
         let beams = room_beams();
         let map = room(&beams);
         let m = matcher();
-        let at_truth = m.score(&map, &Xyt { x: 0.0, y: 0.0, t: 0.0 }, &beams);
+        let at_truth = m.score(&map, &Xyt { x: 0.0, y: 0.0, theta: 0.0 }, &beams);
         assert!(at_truth > 0.9 * beams.len() as f64, "{at_truth}");
-        let (p, s) = m.optimize(&map, &Xyt { x: 0.06, y: -0.04, t: 0.03 }, &beams);
-        assert!(p.x.abs() < 0.01 && p.y.abs() < 0.01 && p.t.abs() < 0.005, "{p:?}");
+        let (p, s) = m.optimize(&map, &Xyt { x: 0.06, y: -0.04, theta: 0.03 }, &beams);
+        assert!(p.x.abs() < 0.01 && p.y.abs() < 0.01 && p.theta.abs() < 0.005, "{p:?}");
         assert!(s > 0.9 * at_truth);
-        let e_truth = m.likelihood_and_score(&map, &Xyt { x: 0.0, y: 0.0, t: 0.0 }, &beams);
-        let e_off = m.likelihood_and_score(&map, &Xyt { x: 0.2, y: 0.0, t: 0.0 }, &beams);
+        let e_truth = m.likelihood_and_score(&map, &Xyt { x: 0.0, y: 0.0, theta: 0.0 }, &beams);
+        let e_off = m.likelihood_and_score(&map, &Xyt { x: 0.2, y: 0.0, theta: 0.0 }, &beams);
         assert!(e_truth.likelihood > e_off.likelihood);
         assert_eq!(e_truth.matched, beams.len());
     }
@@ -591,19 +567,19 @@ mod tests {
         for (params, spread, turn, shrink, bound) in
             [(SlamParams::default(), 0.03, 0.03, 2.0, 0.025), (SlamParams::matched(), 0.1, 0.03, 4.0, 0.03)]
         {
-            let m = ScanMatcher::from_params(&params, Xyt { x: 0.0, y: 0.0, t: 0.0 });
+            let m = ScanMatcher::from_params(&params, Xyt { x: 0.0, y: 0.0, theta: 0.0 });
             let mut map = TileMap::new(params.delta);
             for k in 0..10 {
                 let p = at(3.0 + 0.5 * k as f64);
                 let scan = PreparedScan::new(&lidar.scan(&office, &p, 0.0, &mut rng), 20.0, 20.0, 0);
-                let (x, y, t) = mrslam_core::pose::pose_xyt(&p);
+                let Xyt { x, y, theta: t } = Xyt::from_pose(&p);
                 let (sn, cs) = t.sin_cos();
                 for b in &scan.hits {
                     let (dx, dy) = (cs * b.c - sn * b.s, sn * b.c + cs * b.s);
                     map.add_beam_hit(x + b.r * dx, y + b.r * dy, dx, dy).unwrap();
                 }
             }
-            let truth = Xyt { x: 8.3, y: 2.0, t: 0.02 };
+            let truth = Xyt { x: 8.3, y: 2.0, theta: 0.02 };
             let scan = lidar.scan(&office, &at(truth.x), 0.0, &mut rng);
             let scan = PreparedScan::new(&scan, 20.0, 20.0, params.lskip);
             let (nxy, nt) = (Normal::new(0.0, spread).unwrap(), Normal::new(0.0, turn).unwrap());
@@ -615,12 +591,12 @@ mod tests {
                 let init = Xyt {
                     x: truth.x + nxy.sample(&mut rng),
                     y: truth.y + nxy.sample(&mut rng),
-                    t: truth.t + nt.sample(&mut rng),
+                    theta: truth.theta + nt.sample(&mut rng),
                 };
                 let r = m.match_scan(&map, &init, &scan, Some(&prior), &mut scratch);
                 before += (init.x - truth.x).powi(2) + (init.y - truth.y).powi(2);
                 after += (r.pose.x - truth.x).powi(2) + (r.pose.y - truth.y).powi(2);
-                heading += (r.pose.t - truth.t).powi(2);
+                heading += (r.pose.theta - truth.theta).powi(2);
             }
             let (before, after, heading) =
                 ((before / n as f64).sqrt(), (after / n as f64).sqrt(), (heading / n as f64).sqrt());

@@ -14,7 +14,7 @@ use super::StudyError;
 use super::algorithms::study_merger_encoded;
 use super::results::TrialRow;
 use crate::eval::transform_error;
-use mrslam_core::pose::{normalize_angle, pose, pose_xyt};
+use mrslam_core::pose::{Xyt, normalize_angle, pose};
 use mrslam_core::relations::{Relation, StampedPose, pose_at};
 use mrslam_core::{CellState, OccupancyGrid, Pose2, ScanRecord};
 use mrslam_merge::{Algorithm, MapEncoding, MergeParams, merge};
@@ -145,7 +145,7 @@ impl CrossRelation {
     /// `delta⁻¹ · (pose_i⁻¹ · t_i_j · pose_j)`.
     pub fn error(&self, t_i_j: &Pose2) -> (f64, f64) {
         let e = self.delta.inverse() * self.pose_i.inverse() * t_i_j * self.pose_j;
-        let (x, y, t) = pose_xyt(&e);
+        let Xyt { x, y, theta: t } = Xyt::from_pose(&e);
         (x.hypot(y), normalize_angle(t).abs())
     }
 }
@@ -210,12 +210,12 @@ pub fn robust_centre(transforms: &[Pose2]) -> Option<Pose2> {
     if transforms.is_empty() {
         return None;
     }
-    let xyt: Vec<(f64, f64, f64)> = transforms.iter().map(pose_xyt).collect();
-    let (s, c) = xyt.iter().fold((0.0, 0.0), |(s, c), p| (s + p.2.sin(), c + p.2.cos()));
+    let xyt: Vec<Xyt> = transforms.iter().map(Xyt::from_pose).collect();
+    let (s, c) = xyt.iter().fold((0.0, 0.0), |(s, c), p| (s + p.theta.sin(), c + p.theta.cos()));
     let reference = s.atan2(c);
-    let mut xs: Vec<f64> = xyt.iter().map(|p| p.0).collect();
-    let mut ys: Vec<f64> = xyt.iter().map(|p| p.1).collect();
-    let mut ts: Vec<f64> = xyt.iter().map(|p| normalize_angle(p.2 - reference)).collect();
+    let mut xs: Vec<f64> = xyt.iter().map(|p| p.x).collect();
+    let mut ys: Vec<f64> = xyt.iter().map(|p| p.y).collect();
+    let mut ts: Vec<f64> = xyt.iter().map(|p| normalize_angle(p.theta - reference)).collect();
     Some(pose(median(&mut xs), median(&mut ys), normalize_angle(reference + median(&mut ts))))
 }
 
@@ -431,7 +431,7 @@ pub fn merge_pair(
     let estimate = r.transform.map(|x| x.to_pose());
     let error = estimate.and_then(|e| median_error(&e, cross));
     let success = r.accepted && error.is_some_and(|(m, deg)| m <= p.max_error_m && deg <= p.max_error_deg);
-    let deg = |(x, y, t): (f64, f64, f64)| (x, y, t.to_degrees());
+    let deg = |p: Xyt| (p.x, p.y, p.theta.to_degrees());
     Ok(PairRow {
         part_i: i,
         part_j: j,
@@ -439,12 +439,12 @@ pub fn merge_pair(
         relations: cross.len(),
         overlap,
         overlap_smaller,
-        truth: deg(pose_xyt(&truth)),
+        truth: deg(Xyt::from_pose(&truth)),
         truth_error,
         accepted: r.accepted,
         success,
         false_merge: r.accepted && !success,
-        estimate: estimate.map(|e| deg(pose_xyt(&e))),
+        estimate: estimate.map(|e| deg(Xyt::from_pose(&e))),
         error,
         error_to_truth: estimate.map(|e| {
             let (rot, d) = transform_error(&e, &truth);
@@ -654,7 +654,7 @@ mod tests {
         assert_eq!((c[1].stamp_i, c[1].stamp_j), (20.0, 100.0));
         let est = true_transform(c).unwrap();
         let (rot, d) = transform_error(&est, &t);
-        assert!(rot < 1e-9 && d < 1e-9, "{:?}", pose_xyt(&est));
+        assert!(rot < 1e-9 && d < 1e-9, "{:?}", Xyt::from_pose(&est));
         let (m, deg) = median_error(&est, c).unwrap();
         assert!(m < 1e-9 && deg < 1e-7);
         // A stamp in no part (beyond the tolerance) drops its relation.
@@ -666,7 +666,7 @@ mod tests {
     fn the_centre_is_robust_and_headings_wrap() {
         let near_pi = [pose(1.0, 2.0, 3.1), pose(1.1, 2.1, -3.1), pose(0.9, 1.9, 3.13), pose(50.0, -40.0, 0.0)];
         let c = robust_centre(&near_pi).unwrap();
-        let (x, y, t) = pose_xyt(&c);
+        let Xyt { x, y, theta: t } = Xyt::from_pose(&c);
         assert!((x - 1.05).abs() < 1e-9 && (y - 1.95).abs() < 1e-9, "{x} {y}");
         assert!(normalize_angle(t - 3.13).abs() < 0.03, "heading {t}: the outlier must not drag it to 0");
         assert!(robust_centre(&[]).is_none());
