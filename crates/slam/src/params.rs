@@ -68,15 +68,6 @@ pub struct SlamParams {
     pub str: f64,
     /// `stt`: odometry rotation error from rotation (GMapping 0.2).
     pub stt: f64,
-    /// `llsamplerange`: linear range of GMapping's sampling-based likelihood estimate, metres (0.01).
-    /// Kept for parity: GMapping's default proposal (`scanMatch`) does not use it, nor does this one.
-    pub llsamplerange: f64,
-    /// `llsamplestep`: linear step of the sampling-based estimate, metres (0.01). Unused, as in GMapping.
-    pub llsamplestep: f64,
-    /// `lasamplerange`: angular range of the sampling-based estimate, radians (0.005). Unused, as in GMapping.
-    pub lasamplerange: f64,
-    /// `lasamplestep`: angular step of the sampling-based estimate, radians (0.005). Unused, as in GMapping.
-    pub lasamplestep: f64,
     /// `occ_thresh`: a cell of the output map is occupied when hits/visits exceeds this (GMapping 0.25).
     pub occ_thresh: f64,
     /// Not GMapping: match only the beams whose end point finds an occupied cell at the motion-model pose
@@ -186,10 +177,6 @@ impl Default for SlamParams {
             srt: 0.2,
             str: 0.1,
             stt: 0.2,
-            llsamplerange: 0.01,
-            llsamplestep: 0.01,
-            lasamplerange: 0.005,
-            lasamplestep: 0.005,
             occ_thresh: 0.25,
             frontier_guard: false,
             seen_band: 0.0,

@@ -246,7 +246,7 @@ impl Rbpf {
             }
             // First scan: it defines the map frame; every particle maps it from the origin.
             self.odo_pose = Some(odom.pose);
-            return self.update(odom, scan, true);
+            return self.update(scan, true);
         };
 
         let raw = Xyt::from_pose(&relative(&odo_pose, &odom.pose));
@@ -283,7 +283,7 @@ impl Rbpf {
             self.counters.invalid_beams += prepared_invalid;
             return Ok(UpdateOutcome::Skipped(SkipReason::NotMoved));
         }
-        self.update(odom, scan, false)
+        self.update(scan, false)
     }
 
     /// Checks a reading before anything changes.
@@ -326,7 +326,7 @@ impl Rbpf {
     }
 
     /// Matches, weighs, resamples and maps one scan.
-    fn update(&mut self, _odom: &Odometry, scan: &LaserScan, first: bool) -> Result<UpdateOutcome, SlamError> {
+    fn update(&mut self, scan: &LaserScan, first: bool) -> Result<UpdateOutcome, SlamError> {
         let p = &self.params;
         let prepared = PreparedScan::new(scan, p.max_range.min(scan.range_max as f64), p.max_urange, p.lskip);
         self.counters.invalid_beams += prepared.invalid;
