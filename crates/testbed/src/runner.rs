@@ -174,13 +174,48 @@ fn merge_pair(scenario: &Scenario) -> Result<(String, String), RunError> {
     }
 }
 
-/// Runs a scenario end to end.
+/// Runs a scenario end to end: the robots drive and map until the merge time ([`drive`]), each robot's
+/// SLAM is evaluated against the truth ([`evaluate_robots`]), then the maps are merged by each algorithm and
+/// every merge is scored against the true transform ([`merge_maps`]).
 pub fn run(scenario: &Scenario, mut opts: RunOptions) -> Result<RunOutput, RunError> {
     let wall = Instant::now();
     let (host, other) = merge_pair(scenario)?;
     let config = SimConfig { dt: scenario.dt, ..SimConfig::default() };
     let mut sim = Sim::with_config(&scenario.world, scenario.seed, config)?;
     let truth = sim.true_map(scenario.truth_resolution)?;
+    let mut agents = add_robots(scenario, &mut sim, &truth)?;
+    let algorithms = opts.algorithms.clone().unwrap_or_else(|| scenario.merge.algorithms.clone());
+    if let Some(v) = opts.viz.as_deref_mut() {
+        viz_begin(v, &sim, &truth, &agents, &algorithms);
+    }
+    let steps = drive(scenario, &mut sim, &mut agents, &truth, &mut opts)?;
+    let merge_at = sim.time();
+    if let Some(v) = opts.viz.as_deref_mut() {
+        v.set_time(steps, merge_at);
+    }
+    let evaluated = evaluate_robots(&agents, &truth, &mut opts)?;
+    let (results, merges) = merge_maps(scenario, &algorithms, &evaluated, (&host, &other), &truth, &mut opts);
+    let (oa, ob) = (&agents[0].observed, &agents[1].observed);
+    let both = oa.iter().zip(ob).filter(|(x, y)| **x && **y).count();
+    let either = oa.iter().zip(ob).filter(|(x, y)| **x || **y).count();
+    let report = RunReport {
+        scenario: scenario.name.clone(),
+        seed: scenario.seed,
+        sim_s: merge_at,
+        wall_s: wall.elapsed().as_secs_f64(),
+        steps,
+        merge_at_s: merge_at,
+        merge_pair: [host, other],
+        robots: evaluated.robots,
+        merges: results,
+        observed_overlap: if either == 0 { 0.0 } else { both as f64 / either as f64 },
+    };
+    Ok(RunOutput { report, maps: evaluated.maps, truth, merges })
+}
+
+/// Puts the scenario's robots into the simulator, each with its SLAM filter (seeded by the scenario's seed and
+/// the robot's place) and its controller.
+fn add_robots<'s>(scenario: &'s Scenario, sim: &mut Sim, truth: &OccupancyGrid) -> Result<Vec<Agent<'s>>, RunError> {
     let mut agents = Vec::new();
     for (k, r) in scenario.robots.iter().enumerate() {
         let id = sim.add_robot(&r.name, r.model.clone(), r.lidar.clone(), r.slip, r.encoder, r.start)?;
@@ -213,10 +248,19 @@ pub fn run(scenario: &Scenario, mut opts: RunOptions) -> Result<RunOutput, RunEr
             observed: vec![false; truth.width() * truth.height()],
         });
     }
-    let algorithms = opts.algorithms.clone().unwrap_or_else(|| scenario.merge.algorithms.clone());
-    if let Some(v) = opts.viz.as_deref_mut() {
-        viz_begin(v, &sim, &truth, &agents, &algorithms);
-    }
+    Ok(agents)
+}
+
+/// Steps the simulation until the scenario's merge time (or its duration): each step, every robot's
+/// controller sets its command, the world moves, and the scans that came in are fed to the robots' filters.
+/// Returns the number of steps.
+fn drive(
+    scenario: &Scenario,
+    sim: &mut Sim,
+    agents: &mut [Agent],
+    truth: &OccupancyGrid,
+    opts: &mut RunOptions,
+) -> Result<u64, RunError> {
     let dt = scenario.dt;
     let mut steps = 0u64;
     let mut next_progress = 0.0;
@@ -225,7 +269,7 @@ pub fn run(scenario: &Scenario, mut opts: RunOptions) -> Result<RunOutput, RunEr
         if let Some(p) = opts.progress.as_mut()
             && t >= next_progress
         {
-            p(t, expected_end(scenario, &sim, &agents, t));
+            p(t, expected_end(scenario, sim, agents, t));
             next_progress += 1.0;
         }
         let merge_now = match scenario.merge.when {
@@ -234,7 +278,7 @@ pub fn run(scenario: &Scenario, mut opts: RunOptions) -> Result<RunOutput, RunEr
             MergeWhen::At(m) => t >= m - 1e-9,
         };
         if merge_now || t >= scenario.duration - 1e-9 {
-            break;
+            return Ok(steps);
         }
         for a in agents.iter_mut() {
             let true_pose = sim.true_pose(a.id)?;
@@ -276,7 +320,7 @@ pub fn run(scenario: &Scenario, mut opts: RunOptions) -> Result<RunOutput, RunEr
             batches.push(batch);
         }
         if let Some(v) = opts.viz.as_deref_mut() {
-            viz_step(v, steps, sim.time(), &agents, &events, &batches);
+            viz_step(v, steps, sim.time(), agents, &events, &batches);
         }
         // The two filters are independent: update them side by side.
         let (first, rest) = agents.split_at_mut(1);
@@ -284,23 +328,35 @@ pub fn run(scenario: &Scenario, mut opts: RunOptions) -> Result<RunOutput, RunEr
             let mut it = batches.into_iter();
             (it.next().unwrap_or_default(), it.next().unwrap_or_default())
         };
-        let (r0, r1) = rayon::join(|| first[0].process(b0, &truth), || rest[0].process(b1, &truth));
+        let (r0, r1) = rayon::join(|| first[0].process(b0, truth), || rest[0].process(b1, truth));
         r0?;
         r1?;
         if let Some(v) = opts.viz.as_deref_mut() {
-            viz_slam(v, &agents)?;
+            viz_slam(v, agents)?;
         }
     }
-    let merge_at = sim.time();
-    if let Some(v) = opts.viz.as_deref_mut() {
-        v.set_time(steps, merge_at);
-    }
+}
 
-    // Evaluation.
-    let mut robots = BTreeMap::new();
-    let mut maps = BTreeMap::new();
-    let mut frames = BTreeMap::new();
-    let mut end_frames = BTreeMap::new();
+/// Each robot's evaluation against the truth, and what the merge needs of it; by robot name.
+struct Evaluated {
+    /// Report of each robot's SLAM.
+    robots: BTreeMap<String, RobotReport>,
+    /// Each robot's final map (best particle), in its own SLAM frame.
+    maps: BTreeMap<String, OccupancyGrid>,
+    /// Each robot's SLAM frame in the world: its true pose at its first processed scan.
+    frames: BTreeMap<String, Pose2>,
+    /// Each robot's SLAM frame placed so that its last SLAM pose is its true pose.
+    end_frames: BTreeMap<String, Pose2>,
+}
+
+/// Scores each robot's SLAM trajectory and map against the truth and takes its final map.
+fn evaluate_robots(agents: &[Agent], truth: &OccupancyGrid, opts: &mut RunOptions) -> Result<Evaluated, RunError> {
+    let mut out = Evaluated {
+        robots: BTreeMap::new(),
+        maps: BTreeMap::new(),
+        frames: BTreeMap::new(),
+        end_frames: BTreeMap::new(),
+    };
     for (k, a) in agents.iter().enumerate() {
         let map = a.slam.map().map_err(|error| RunError::Slam { robot: a.setup.name.clone(), error })?;
         let traj: Vec<Pose2> = a.slam.trajectory().into_iter().map(|(_, p)| p).collect();
@@ -312,12 +368,12 @@ pub fn run(scenario: &Scenario, mut opts: RunOptions) -> Result<RunOutput, RunEr
             _ => 0.0,
         };
         let counters = a.slam.counters();
-        robots.insert(
+        out.robots.insert(
             a.setup.name.clone(),
             RobotReport {
                 slam_rmse_m: rmse(&traj, &truth_rel),
                 odom_rmse_m: rmse(&odom_rel, &truth_rel),
-                map_acceptance: map_acceptance(&truth, &map, &t0),
+                map_acceptance: map_acceptance(truth, &map, &t0),
                 slam_final_error_m: final_err(&traj),
                 odom_final_error_m: final_err(&odom_rel),
                 scans: a.scans,
@@ -335,22 +391,34 @@ pub fn run(scenario: &Scenario, mut opts: RunOptions) -> Result<RunOutput, RunEr
             v.map(k, &map);
             v.paths(k, &traj);
         }
-        // The map frame placed so that the robot's last SLAM pose is its true pose.
         let end_frame = match (a.processed.last(), traj.last()) {
             (Some((t, _)), Some(e)) => t * e.inverse(),
             _ => t0,
         };
-        end_frames.insert(a.setup.name.clone(), end_frame);
-        frames.insert(a.setup.name.clone(), t0);
-        maps.insert(a.setup.name.clone(), map);
+        out.end_frames.insert(a.setup.name.clone(), end_frame);
+        out.frames.insert(a.setup.name.clone(), t0);
+        out.maps.insert(a.setup.name.clone(), map);
     }
-    let true_t = frames[&host].inv_mul(&frames[&other]);
-    let end_t = end_frames[&host].inv_mul(&end_frames[&other]);
+    Ok(out)
+}
+
+/// Merges the other robot's map into the host's with each algorithm and scores each merge against the true
+/// transform between the two SLAM frames (and against the one at the end of the run).
+fn merge_maps(
+    scenario: &Scenario,
+    algorithms: &[Algorithm],
+    evaluated: &Evaluated,
+    (host, other): (&str, &str),
+    truth: &OccupancyGrid,
+    opts: &mut RunOptions,
+) -> (Vec<MergeResult>, Vec<MergeOutcome>) {
+    let true_t = evaluated.frames[host].inv_mul(&evaluated.frames[other]);
+    let end_t = evaluated.end_frames[host].inv_mul(&evaluated.end_frames[other]);
     let mut merges = Vec::new();
     let mut results = Vec::new();
-    for &algorithm in &algorithms {
+    for &algorithm in algorithms {
         let merger = merger_for(algorithm, scenario);
-        let out = merge(merger.as_ref(), &maps[&host], &maps[&other], &MergeParams::default());
+        let out = merge(merger.as_ref(), &evaluated.maps[host], &evaluated.maps[other], &MergeParams::default());
         let err = out.report.transform.map(|t| transform_error(&t.to_pose(), &true_t));
         let err_at_end = out.report.transform.map(|t| transform_error(&t.to_pose(), &end_t));
         let success = out.report.accepted
@@ -366,7 +434,7 @@ pub fn run(scenario: &Scenario, mut opts: RunOptions) -> Result<RunOutput, RunEr
             rotation_error_at_end_deg: err_at_end.map(|e| e.0.to_degrees()),
             translation_error_at_end_m: err_at_end.map(|e| e.1),
             acceptance_index: out.report.acceptance_index,
-            merged_map_acceptance: out.merged.as_ref().map(|m| map_acceptance(&truth, m, &frames[&host])),
+            merged_map_acceptance: out.merged.as_ref().map(|m| map_acceptance(truth, m, &evaluated.frames[host])),
             time_ms: out.report.time_ms,
             reason: out.report.reason.clone(),
             transform: out.report.transform,
@@ -376,26 +444,11 @@ pub fn run(scenario: &Scenario, mut opts: RunOptions) -> Result<RunOutput, RunEr
             matches: out.report.matches,
         });
         if let Some(v) = opts.viz.as_deref_mut() {
-            v.merge(&merge_view(&out, &host, &other, err));
+            v.merge(&merge_view(&out, host, other, err));
         }
         merges.push(out);
     }
-    let (oa, ob) = (&agents[0].observed, &agents[1].observed);
-    let both = oa.iter().zip(ob).filter(|(x, y)| **x && **y).count();
-    let either = oa.iter().zip(ob).filter(|(x, y)| **x || **y).count();
-    let report = RunReport {
-        scenario: scenario.name.clone(),
-        seed: scenario.seed,
-        sim_s: merge_at,
-        wall_s: wall.elapsed().as_secs_f64(),
-        steps,
-        merge_at_s: merge_at,
-        merge_pair: [host, other],
-        robots,
-        merges: results,
-        observed_overlap: if either == 0 { 0.0 } else { both as f64 / either as f64 },
-    };
-    Ok(RunOutput { report, maps, truth, merges })
+    (results, merges)
 }
 
 /// When the run is expected to end, simulated seconds: a fixed merge time or the duration; at a rendezvous
