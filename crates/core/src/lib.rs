@@ -12,6 +12,7 @@ pub mod pose;
 pub mod raycast;
 pub mod relations;
 pub mod scan;
+pub mod sensor;
 pub mod toml_lines;
 
 pub use carmen::{CarmenError, CarmenLog, LaserSource, OdometrySource, ReadOptions, Repairs, ScanRecord};

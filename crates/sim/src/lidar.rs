@@ -12,6 +12,7 @@
 use crate::error::{SimError, bad_param, check_non_negative, check_positive};
 use mrslam_core::Pose2;
 use mrslam_core::Xyt;
+use mrslam_core::sensor::{self, LidarSpec};
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
@@ -47,40 +48,33 @@ pub struct LidarModel {
 }
 
 impl LidarModel {
-    /// Hokuyo URG-04LX: 240°, 0.36° (667 beams), 0.06–4 m, 100 ms, ±10 mm / 1 % noise. Experia's lidar.
-    pub fn hokuyo_urg_04lx() -> Self {
+    /// A lidar of specification `spec` mounted at `mount` in the robot frame.
+    pub fn from_spec(spec: &LidarSpec, mount: Pose2) -> Self {
         LidarModel {
-            name: "hokuyo_urg_04lx".into(),
-            fov: 240f64.to_radians(),
-            resolution: 0.36f64.to_radians(),
-            range_min: 0.06,
-            range_max: 4.0,
-            scan_period: 0.1,
-            range_noise_const: 0.01,
-            range_noise_prop: 0.005,
-            angular_jitter: 0.0,
-            dropout_prob: 0.002,
-            mount: Pose2::new(nalgebra::Vector2::new(0.15, 0.0), 0.0),
-            skew: false,
+            name: spec.name.into(),
+            fov: spec.fov,
+            resolution: spec.resolution,
+            range_min: spec.range_min,
+            range_max: spec.range_max,
+            scan_period: spec.scan_period,
+            range_noise_const: spec.range_noise_const,
+            range_noise_prop: spec.range_noise_prop,
+            angular_jitter: spec.angular_jitter,
+            dropout_prob: spec.dropout_prob,
+            mount,
+            skew: spec.skew,
         }
     }
 
-    /// Slamtec RPLIDAR A1: 360°, 1° (360 beams), 0.2–6 m, 200 ms, ~1 % noise, skewed. Prawn's lidar.
+    /// Hokuyo URG-04LX ([`LidarSpec::hokuyo_urg_04lx`]) mounted 0.15 m ahead of the robot's centre. Experia's
+    /// lidar.
+    pub fn hokuyo_urg_04lx() -> Self {
+        Self::from_spec(&LidarSpec::hokuyo_urg_04lx(), Pose2::new(nalgebra::Vector2::new(0.15, 0.0), 0.0))
+    }
+
+    /// Slamtec RPLIDAR A1 ([`LidarSpec::rplidar_a1`]) at the robot's centre. Prawn's lidar.
     pub fn rplidar_a1() -> Self {
-        LidarModel {
-            name: "rplidar_a1".into(),
-            fov: TAU,
-            resolution: 1f64.to_radians(),
-            range_min: 0.2,
-            range_max: 6.0,
-            scan_period: 0.2,
-            range_noise_const: 0.005,
-            range_noise_prop: 0.01,
-            angular_jitter: 0.1f64.to_radians(),
-            dropout_prob: 0.01,
-            mount: Pose2::identity(),
-            skew: true,
-        }
+        Self::from_spec(&LidarSpec::rplidar_a1(), Pose2::identity())
     }
 
     /// The same model without any noise, jitter or dropouts (geometry only).
@@ -94,16 +88,12 @@ impl LidarModel {
 
     /// True when the field of view is a full turn.
     pub fn is_full_circle(&self) -> bool {
-        self.fov >= TAU - 1e-9
+        sensor::is_full_circle(self.fov)
     }
 
     /// Number of beams: `fov / resolution` for a full turn, `floor(fov / resolution) + 1` otherwise.
     pub fn beam_count(&self) -> usize {
-        if self.is_full_circle() {
-            (TAU / self.resolution).round().max(1.0) as usize
-        } else {
-            (self.fov / self.resolution + 1e-9).floor() as usize + 1
-        }
+        sensor::beam_count(self.fov, self.resolution)
     }
 
     /// Angle of the first beam in the sensor frame (the pattern is centred on the sensor's x axis).

@@ -4,6 +4,7 @@
 //! Nothing here knows about the simulator crate: it uses core's grid ray casting only.
 
 use mrslam_core::pose::{Xyt, normalize_angle, relative};
+use mrslam_core::sensor::LidarSpec;
 use mrslam_core::{LaserScan, OccupancyGrid, Odometry, Pose2, pose};
 use nalgebra::Point2;
 use rand::{Rng, SeedableRng};
@@ -48,10 +49,27 @@ impl Lidar {
         }
     }
 
-    /// [`Lidar::hokuyo`] with the simulator's noise model (`mrslam-sim`'s `hokuyo_urg_04lx`): 1 cm + 0.5 % of
-    /// the range, 0.2 % dropouts. (Its mount, 0.15 m ahead, is the run's laser offset.)
+    /// The lidar of a data-sheet specification: its beam pattern, range limits, range noise and dropouts
+    /// (angular jitter and scan skew are the simulator's alone).
+    pub fn from_spec(spec: &LidarSpec) -> Self {
+        let beams = spec.beam_count();
+        let fov = if spec.is_full_circle() { spec.fov } else { (beams - 1) as f64 * spec.resolution };
+        Lidar {
+            fov,
+            beams,
+            range_min: spec.range_min as f32,
+            range_max: spec.range_max as f32,
+            sigma: spec.range_noise_const,
+            sigma_per_m: spec.range_noise_prop,
+            dropout: spec.dropout_prob,
+        }
+    }
+
+    /// The simulator's Hokuyo ([`LidarSpec::hokuyo_urg_04lx`]): [`Lidar::hokuyo`]'s beams with the data
+    /// sheet's noise, 1 cm + 0.5 % of the range, and 0.2 % dropouts. (Its mount, 0.15 m ahead, is the run's
+    /// laser offset.)
     pub fn hokuyo_as_simulated() -> Self {
-        Lidar { sigma_per_m: 0.005, dropout: 0.002, ..Self::hokuyo() }
+        Self::from_spec(&LidarSpec::hokuyo_urg_04lx())
     }
 
     /// SICK LMS class, as on the benchmark logs' robots: 180°, 181 beams (1°), 20 m here, 1 cm noise.
