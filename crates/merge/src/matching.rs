@@ -56,22 +56,11 @@ fn dist2(a: &[u8], b: &[u8]) -> u32 {
     s as u32
 }
 
-/// Nearest and second-nearest squared distances from `q` to the descriptors of `set`, with the nearest index.
-fn two_nearest(q: &[u8], set: &[u8]) -> (usize, u32, u32) {
-    #[cfg(target_arch = "x86_64")]
-    {
-        if std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: the CPU supports AVX2 (checked just above).
-            return unsafe { two_nearest_avx2(q, set) };
-        }
-    }
-    two_nearest_impl(q, set)
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-fn two_nearest_avx2(q: &[u8], set: &[u8]) -> (usize, u32, u32) {
-    two_nearest_impl(q, set)
+mrslam_sift::cpu_dispatch! {
+    /// Nearest and second-nearest squared distances from `q` to the descriptors of `set`, with the nearest index.
+    fn two_nearest(q: &[u8], set: &[u8]) -> (usize, u32, u32);
+    "avx2" => two_nearest_avx2 => two_nearest_impl(q, set);
+    _ => two_nearest_impl(q, set)
 }
 
 #[inline(always)]
@@ -90,22 +79,11 @@ fn two_nearest_impl(q: &[u8], set: &[u8]) -> (usize, u32, u32) {
     (bi, b1, b2)
 }
 
-/// The `k` nearest descriptors of `set` to `q` as (index, squared distance), nearest first.
-fn k_nearest(q: &[u8], set: &[u8], k: usize, out: &mut Vec<(usize, u32)>) {
-    #[cfg(target_arch = "x86_64")]
-    {
-        if std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: the CPU supports AVX2 (checked just above).
-            return unsafe { k_nearest_avx2(q, set, k, out) };
-        }
-    }
-    k_nearest_impl(q, set, k, out)
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-fn k_nearest_avx2(q: &[u8], set: &[u8], k: usize, out: &mut Vec<(usize, u32)>) {
-    k_nearest_impl(q, set, k, out)
+mrslam_sift::cpu_dispatch! {
+    /// The `k` nearest descriptors of `set` to `q` as (index, squared distance), nearest first.
+    fn k_nearest(q: &[u8], set: &[u8], k: usize, out: &mut Vec<(usize, u32)>);
+    "avx2" => k_nearest_avx2 => k_nearest_impl(q, set, k, out);
+    _ => k_nearest_impl(q, set, k, out)
 }
 
 #[inline(always)]

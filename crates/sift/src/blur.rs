@@ -184,57 +184,23 @@ pub fn blur_band(
     blur_rows(&src[..w * h], &mut dst[y0 * w..y1 * w], w, h, y0, kernel, scratch, sparse);
 }
 
-/// Blurs output rows `y0 .. y0 + out.len() / w` into `out`.
-#[allow(clippy::too_many_arguments)]
-fn blur_rows(
-    src: &[f32],
-    out: &mut [f32],
-    w: usize,
-    h: usize,
-    y0: usize,
-    kernel: &Kernel,
-    s: &mut BlurScratch,
-    sparse: Option<Sparse<'_>>,
-) {
-    #[cfg(target_arch = "x86_64")]
-    {
-        if std::arch::is_x86_feature_detected!("avx512f") {
-            // SAFETY: the CPU supports AVX-512F (checked just above).
-            unsafe { blur_rows_avx512(src, out, w, h, y0, kernel, s, sparse) };
-            return;
-        }
-        if std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: the CPU supports AVX2 (checked just above).
-            unsafe { blur_rows_avx2(src, out, w, h, y0, kernel, s, sparse) };
-            return;
-        }
-    }
-    blur_rows_impl(src, out, w, h, y0, kernel, s, sparse);
+crate::cpu_dispatch! {
+    /// Blurs output rows `y0 .. y0 + out.len() / w` into `out`.
+    #[allow(clippy::too_many_arguments)]
+    fn blur_rows(
+        src: &[f32],
+        out: &mut [f32],
+        w: usize,
+        h: usize,
+        y0: usize,
+        kernel: &Kernel,
+        s: &mut BlurScratch,
+        sparse: Option<Sparse<'_>>,
+    );
+    "avx512f" => blur_rows_avx512 => blur_rows_impl(src, out, w, h, y0, kernel, s, sparse);
+    "avx2" => blur_rows_avx2 => blur_rows_impl(src, out, w, h, y0, kernel, s, sparse);
+    _ => blur_rows_impl(src, out, w, h, y0, kernel, s, sparse)
 }
-
-/// A copy of `blur_rows_impl` compiled with a target feature (picked at run time by `blur_rows`).
-macro_rules! blur_rows_with_feature {
-    ($name:ident, $feature:literal) => {
-        #[cfg(target_arch = "x86_64")]
-        #[target_feature(enable = $feature)]
-        #[allow(clippy::too_many_arguments)]
-        fn $name(
-            src: &[f32],
-            out: &mut [f32],
-            w: usize,
-            h: usize,
-            y0: usize,
-            kernel: &Kernel,
-            s: &mut BlurScratch,
-            sparse: Option<Sparse<'_>>,
-        ) {
-            blur_rows_impl(src, out, w, h, y0, kernel, s, sparse);
-        }
-    };
-}
-
-blur_rows_with_feature!(blur_rows_avx2, "avx2");
-blur_rows_with_feature!(blur_rows_avx512, "avx512f");
 
 /// Rows computed together: with [`CHUNK`] columns each, enough independent accumulator chains to hide
 /// the add latency, whatever the width of the active spans.

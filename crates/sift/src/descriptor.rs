@@ -117,37 +117,13 @@ pub struct Frame {
     pub scl: f32,
 }
 
-/// Computes the descriptor of Gaussian image `img` (`w` x `h`) in frame `at`.
-pub fn descriptor(img: &[f32], w: usize, h: usize, at: Frame, out: &mut [u8], s: &mut DescScratch) {
-    #[cfg(target_arch = "x86_64")]
-    {
-        if std::arch::is_x86_feature_detected!("avx512f") {
-            // SAFETY: the CPU supports AVX-512F (checked just above).
-            unsafe { descriptor_avx512(img, w, h, at, out, s) };
-            return;
-        }
-        if std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: the CPU supports AVX2 (checked just above).
-            unsafe { descriptor_avx2(img, w, h, at, out, s) };
-            return;
-        }
-    }
-    descriptor_impl::<false>(img, w, h, at, out, s);
+crate::cpu_dispatch! {
+    /// Computes the descriptor of Gaussian image `img` (`w` x `h`) in frame `at`.
+    pub fn descriptor(img: &[f32], w: usize, h: usize, at: Frame, out: &mut [u8], s: &mut DescScratch);
+    "avx512f" => descriptor_avx512 => descriptor_impl::<true>(img, w, h, at, out, s);
+    "avx2" => descriptor_avx2 => descriptor_impl::<false>(img, w, h, at, out, s);
+    _ => descriptor_impl::<false>(img, w, h, at, out, s)
 }
-
-/// A copy of [`descriptor_impl`] compiled with a target feature (picked at run time by [`descriptor`]).
-macro_rules! descriptor_with_feature {
-    ($name:ident, $feature:literal, $avx512:literal) => {
-        #[cfg(target_arch = "x86_64")]
-        #[target_feature(enable = $feature)]
-        fn $name(img: &[f32], w: usize, h: usize, at: Frame, out: &mut [u8], s: &mut DescScratch) {
-            descriptor_impl::<$avx512>(img, w, h, at, out, s);
-        }
-    };
-}
-
-descriptor_with_feature!(descriptor_avx512, "avx512f", true);
-descriptor_with_feature!(descriptor_avx2, "avx2", false);
 
 /// The descriptor; with `AVX512` (only when the caller has that target feature), the window's samples
 /// are gathered 16 columns at a time (the same values in the same order as the scalar loop).

@@ -62,76 +62,42 @@ pub struct DogRows {
     hmin: Vec<f32>,
 }
 
-/// Appends to `out` the 26-neighbour extrema of DoG layers `1..=n_layers` (OpenCV's test: `|D| > threshold`
-/// and `D >= all neighbours` when positive, `<=` when negative), skipping `border` pixels at the edges.
-///
-/// DoG rows are formed once each into a small rolling buffer together with their 3-wide running max and
-/// min, so the 3x3x3 maximum (which may include the centre: `D >= max` is the same test) costs 9 loads per
-/// pixel. Chunks of pixels all below the threshold are skipped first; everything runs on whole chunks
-/// (vectorised), with AVX2 / AVX-512 copies picked at run time.
-///
-/// Only rows `rows` (clamped to `border .. h - border`) are scanned, so a caller can scan an octave in
-/// consecutive row ranges as its layers become available (Gaussian rows up to `rows.end` must be final);
-/// the ranges must start at `border` and follow each other (the rolling buffer carries over).
-///
-/// With `mask` (chunks of 16 columns from column `border`, one row of chunks per image row), only the
-/// masked chunks are scanned, and DoG rows are formed only where those scans read them; the caller
-/// guarantees that no pixel outside the mask has `|D| > threshold` in any tested layer, so the candidates
-/// (and their order) are those of the full scan.
-#[allow(clippy::too_many_arguments)]
-pub fn find_candidates(
-    gauss: &[Vec<f32>],
-    w: usize,
-    h: usize,
-    n_layers: usize,
-    threshold: f32,
-    border: usize,
-    rows: std::ops::Range<usize>,
-    mask: Option<&ChunkMask>,
-    ring: &mut DogRows,
-    out: &mut Vec<Candidate>,
-) {
-    #[cfg(target_arch = "x86_64")]
-    {
-        if std::arch::is_x86_feature_detected!("avx512f") {
-            // SAFETY: the CPU supports AVX-512F (checked just above).
-            unsafe { find_candidates_avx512(gauss, w, h, n_layers, threshold, border, rows, mask, ring, out) };
-            return;
-        }
-        if std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: the CPU supports AVX2 (checked just above).
-            unsafe { find_candidates_avx2(gauss, w, h, n_layers, threshold, border, rows, mask, ring, out) };
-            return;
-        }
-    }
-    find_candidates_impl(gauss, w, h, n_layers, threshold, border, rows, mask, ring, out);
+crate::cpu_dispatch! {
+    /// Appends to `out` the 26-neighbour extrema of DoG layers `1..=n_layers` (OpenCV's test: `|D| > threshold`
+    /// and `D >= all neighbours` when positive, `<=` when negative), skipping `border` pixels at the edges.
+    ///
+    /// DoG rows are formed once each into a small rolling buffer together with their 3-wide running max and
+    /// min, so the 3x3x3 maximum (which may include the centre: `D >= max` is the same test) costs 9 loads per
+    /// pixel. Chunks of pixels all below the threshold are skipped first; everything runs on whole chunks
+    /// (vectorised), with AVX2 / AVX-512 copies picked at run time.
+    ///
+    /// Only rows `rows` (clamped to `border .. h - border`) are scanned, so a caller can scan an octave in
+    /// consecutive row ranges as its layers become available (Gaussian rows up to `rows.end` must be final);
+    /// the ranges must start at `border` and follow each other (the rolling buffer carries over).
+    ///
+    /// With `mask` (chunks of 16 columns from column `border`, one row of chunks per image row), only the
+    /// masked chunks are scanned, and DoG rows are formed only where those scans read them; the caller
+    /// guarantees that no pixel outside the mask has `|D| > threshold` in any tested layer, so the candidates
+    /// (and their order) are those of the full scan.
+    #[allow(clippy::too_many_arguments)]
+    pub fn find_candidates(
+        gauss: &[Vec<f32>],
+        w: usize,
+        h: usize,
+        n_layers: usize,
+        threshold: f32,
+        border: usize,
+        rows: std::ops::Range<usize>,
+        mask: Option<&ChunkMask>,
+        ring: &mut DogRows,
+        out: &mut Vec<Candidate>,
+    );
+    "avx512f" => find_candidates_avx512 =>
+        find_candidates_impl(gauss, w, h, n_layers, threshold, border, rows, mask, ring, out);
+    "avx2" => find_candidates_avx2 =>
+        find_candidates_impl(gauss, w, h, n_layers, threshold, border, rows, mask, ring, out);
+    _ => find_candidates_impl(gauss, w, h, n_layers, threshold, border, rows, mask, ring, out)
 }
-
-/// A copy of `find_candidates_impl` compiled with a target feature (picked at run time by [`find_candidates`]).
-macro_rules! find_candidates_with_feature {
-    ($name:ident, $feature:literal) => {
-        #[cfg(target_arch = "x86_64")]
-        #[target_feature(enable = $feature)]
-        #[allow(clippy::too_many_arguments)]
-        fn $name(
-            gauss: &[Vec<f32>],
-            w: usize,
-            h: usize,
-            n_layers: usize,
-            threshold: f32,
-            border: usize,
-            rows: std::ops::Range<usize>,
-            mask: Option<&ChunkMask>,
-            ring: &mut DogRows,
-            out: &mut Vec<Candidate>,
-        ) {
-            find_candidates_impl(gauss, w, h, n_layers, threshold, border, rows, mask, ring, out);
-        }
-    };
-}
-
-find_candidates_with_feature!(find_candidates_avx512, "avx512f");
-find_candidates_with_feature!(find_candidates_avx2, "avx2");
 
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]

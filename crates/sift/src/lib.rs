@@ -16,6 +16,7 @@
 
 mod blur;
 mod descriptor;
+mod dispatch;
 mod error;
 mod extrema;
 mod fastmath;

@@ -75,20 +75,7 @@ impl BitMask {
     /// The edge mask of `img` (`w x h`): both pixels of every 4-adjacent pair whose bits differ, and every
     /// pixel that is not finite or exceeds [`MAX_FLAT`] in magnitude.
     pub fn edges_of(&mut self, img: &[f32], w: usize, h: usize) -> Flat {
-        #[cfg(target_arch = "x86_64")]
-        {
-            if std::arch::is_x86_feature_detected!("avx2") {
-                // SAFETY: the CPU supports AVX2 (checked just above).
-                return unsafe { self.edges_avx2(img, w, h) };
-            }
-        }
-        self.edges_impl::<false>(img, w, h)
-    }
-
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    fn edges_avx2(&mut self, img: &[f32], w: usize, h: usize) -> Flat {
-        self.edges_impl::<true>(img, w, h)
+        edges(self, img, w, h)
     }
 
     #[inline(always)]
@@ -323,6 +310,13 @@ impl BitMask {
             *a &= b;
         }
     }
+}
+
+crate::cpu_dispatch! {
+    /// [`BitMask::edges_of`], its AVX2 copy picked at run time.
+    fn edges(mask: &mut BitMask, img: &[f32], w: usize, h: usize) -> Flat;
+    "avx2" => edges_avx2 => mask.edges_impl::<true>(img, w, h);
+    _ => mask.edges_impl::<false>(img, w, h)
 }
 
 /// Bit `j` (0..4) set when any of bits `16 j .. 16 j + 16` of `word` is.

@@ -21,45 +21,23 @@ pub struct OriScratch {
     ex: Vec<f32>,
 }
 
-/// Smoothed orientation histogram around integer pixel (`x`, `y`) of Gaussian image `img` (`w` x `h`);
-/// returns its maximum.
-#[allow(clippy::too_many_arguments)]
-pub fn orientation_hist(
-    img: &[f32],
-    w: usize,
-    h: usize,
-    x: usize,
-    y: usize,
-    radius: i32,
-    sigma: f32,
-    hist: &mut [f32; ORI_HIST_BINS],
-    s: &mut OriScratch,
-) -> f32 {
-    #[cfg(target_arch = "x86_64")]
-    {
-        if std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: the CPU supports AVX2 (checked just above).
-            return unsafe { orientation_hist_avx2(img, w, h, x, y, radius, sigma, hist, s) };
-        }
-    }
-    orientation_hist_impl(img, w, h, x, y, radius, sigma, hist, s)
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-#[allow(clippy::too_many_arguments)]
-fn orientation_hist_avx2(
-    img: &[f32],
-    w: usize,
-    h: usize,
-    x: usize,
-    y: usize,
-    radius: i32,
-    sigma: f32,
-    hist: &mut [f32; ORI_HIST_BINS],
-    s: &mut OriScratch,
-) -> f32 {
-    orientation_hist_impl(img, w, h, x, y, radius, sigma, hist, s)
+crate::cpu_dispatch! {
+    /// Smoothed orientation histogram around integer pixel (`x`, `y`) of Gaussian image `img` (`w` x `h`);
+    /// returns its maximum.
+    #[allow(clippy::too_many_arguments)]
+    pub fn orientation_hist(
+        img: &[f32],
+        w: usize,
+        h: usize,
+        x: usize,
+        y: usize,
+        radius: i32,
+        sigma: f32,
+        hist: &mut [f32; ORI_HIST_BINS],
+        s: &mut OriScratch,
+    ) -> f32;
+    "avx2" => orientation_hist_avx2 => orientation_hist_impl(img, w, h, x, y, radius, sigma, hist, s);
+    _ => orientation_hist_impl(img, w, h, x, y, radius, sigma, hist, s)
 }
 
 #[inline(always)]
