@@ -7,6 +7,7 @@
 //! compiled for it is picked at run time. No fused multiply-add is used, so every copy gives bit-identical
 //! results.
 
+use crate::image::Plane;
 use crate::mask::{CHUNK, ChunkMask, ChunkRuns};
 use rayon::prelude::*;
 
@@ -137,69 +138,62 @@ impl<'a> ConstCache<'a> {
 /// Blurs `src` (`w` x `h`, row-major) into `dst` with `kernel`; `scratch` is reused. With `parallel`,
 /// bands of rows are spread over the rayon pool; with `sparse`, only the masked chunks are computed and
 /// the others are filled with their constant. Same result every way, bit for bit.
-#[allow(clippy::too_many_arguments)]
 pub fn blur(
-    src: &[f32],
+    src: Plane<'_>,
     dst: &mut [f32],
-    w: usize,
-    h: usize,
     kernel: &Kernel,
     scratch: &mut BlurScratch,
     parallel: bool,
     sparse: Option<Sparse<'_>>,
 ) {
+    let (w, h) = (src.w, src.h);
     let n = w * h;
     if n == 0 {
         return;
     }
-    let (src, dst) = (&src[..n], &mut dst[..n]);
+    let (src, dst) = (Plane::new(&src.data[..n], w, h), &mut dst[..n]);
     if parallel && h >= 64 {
         let band = h.div_ceil(rayon::current_num_threads().max(1) * 4).max(8);
         dst.par_chunks_mut(band * w).enumerate().for_each(|(b, chunk)| {
             let mut s = BlurScratch::default();
-            blur_rows(src, chunk, w, h, b * band, kernel, &mut s, sparse);
+            blur_rows(src, chunk, b * band, kernel, &mut s, sparse);
         });
     } else {
-        blur_rows(src, dst, w, h, 0, kernel, scratch, sparse);
+        blur_rows(src, dst, 0, kernel, scratch, sparse);
     }
 }
 
 /// Blurs rows `y0 .. y1` of `dst` from `src` (both `w x h`); `src` rows up to `min(h, y1 + radius)` (and
 /// the first `radius` rows) must be final. Used to run the layers of an octave as a cache-friendly wavefront.
-#[allow(clippy::too_many_arguments)]
 pub fn blur_band(
-    src: &[f32],
+    src: Plane<'_>,
     dst: &mut [f32],
-    w: usize,
-    h: usize,
     y0: usize,
     y1: usize,
     kernel: &Kernel,
     scratch: &mut BlurScratch,
     sparse: Option<Sparse<'_>>,
 ) {
+    let (w, h) = (src.w, src.h);
     if w == 0 || y0 >= y1 {
         return;
     }
-    blur_rows(&src[..w * h], &mut dst[y0 * w..y1 * w], w, h, y0, kernel, scratch, sparse);
+    blur_rows(Plane::new(&src.data[..w * h], w, h), &mut dst[y0 * w..y1 * w], y0, kernel, scratch, sparse);
 }
 
 crate::cpu_dispatch! {
     /// Blurs output rows `y0 .. y0 + out.len() / w` into `out`.
-    #[allow(clippy::too_many_arguments)]
     fn blur_rows(
-        src: &[f32],
+        src: Plane<'_>,
         out: &mut [f32],
-        w: usize,
-        h: usize,
         y0: usize,
         kernel: &Kernel,
         s: &mut BlurScratch,
         sparse: Option<Sparse<'_>>,
     );
-    "avx512f" => blur_rows_avx512 => blur_rows_impl(src, out, w, h, y0, kernel, s, sparse);
-    "avx2" => blur_rows_avx2 => blur_rows_impl(src, out, w, h, y0, kernel, s, sparse);
-    _ => blur_rows_impl(src, out, w, h, y0, kernel, s, sparse)
+    "avx512f" => blur_rows_avx512 => blur_rows_impl(src, out, y0, kernel, s, sparse);
+    "avx2" => blur_rows_avx2 => blur_rows_impl(src, out, y0, kernel, s, sparse);
+    _ => blur_rows_impl(src, out, y0, kernel, s, sparse)
 }
 
 /// Rows computed together: with [`CHUNK`] columns each, enough independent accumulator chains to hide
@@ -345,17 +339,15 @@ fn quad_rows(q: usize, gn: usize) -> [usize; QUAD] {
 }
 
 #[inline(always)]
-#[allow(clippy::too_many_arguments)]
 fn blur_rows_impl(
-    src: &[f32],
+    src: Plane<'_>,
     out: &mut [f32],
-    w: usize,
-    h: usize,
     y0: usize,
     kernel: &Kernel,
     s: &mut BlurScratch,
     sparse: Option<Sparse<'_>>,
 ) {
+    let Plane { data: src, w, h } = src;
     let k = &kernel.half[..];
     let r = k.len() - 1;
     let stride = w + 2 * r;
@@ -603,18 +595,18 @@ mod tests {
             let k = Kernel::gaussian(2.0);
             let mut dst = vec![0.0; w * h];
             let mut buf = BlurScratch::default();
-            blur(&src, &mut dst, w, h, &k, &mut buf, false, None);
+            blur(Plane::new(&src, w, h), &mut dst, &k, &mut buf, false, None);
             let expect = naive(&src, w, h, &k);
             for (a, b) in dst.iter().zip(&expect) {
                 assert!((a - b).abs() < 1e-3, "{a} vs {b}");
             }
             let mut par = vec![0.0; w * h];
-            blur(&src, &mut par, w, h, &k, &mut buf, true, None);
+            blur(Plane::new(&src, w, h), &mut par, &k, &mut buf, true, None);
             assert_eq!(par, dst);
         }
         let src = vec![100.0f32; 64 * 70];
         let mut dst = vec![0.0; 64 * 70];
-        blur(&src, &mut dst, 64, 70, &Kernel::gaussian(3.0), &mut BlurScratch::default(), true, None);
+        blur(Plane::new(&src, 64, 70), &mut dst, &Kernel::gaussian(3.0), &mut BlurScratch::default(), true, None);
         assert!(dst.iter().all(|v| (v - 100.0).abs() < 1e-3));
     }
 
@@ -669,7 +661,7 @@ mod tests {
                 let want = paired(&src, w, h, &k);
                 let mut s = BlurScratch::default();
                 let mut dense = vec![0.0; w * h];
-                blur(&src, &mut dense, w, h, &k, &mut s, false, None);
+                blur(Plane::new(&src, w, h), &mut dense, &k, &mut s, false, None);
                 // Sparse: masks from the source's edges grown by the radius (as the pyramid does).
                 let (mut edges, mut vm, mut am) = (BitMask::default(), BitMask::default(), BitMask::default());
                 edges.edges_of(&src, w, h);
@@ -679,7 +671,7 @@ mod tests {
                 vert.build(&vm, 0, w);
                 out.build(&am, 0, w);
                 let mut sparse = vec![f32::NAN; w * h];
-                blur(&src, &mut sparse, w, h, &k, &mut s, false, Some(Sparse { vert: &vert, out: &out }));
+                blur(Plane::new(&src, w, h), &mut sparse, &k, &mut s, false, Some(Sparse { vert: &vert, out: &out }));
                 for i in 0..w * h {
                     assert_eq!(dense[i].to_bits(), want[i].to_bits(), "dense {w}x{h} sigma {sigma} at {i}");
                     assert_eq!(sparse[i].to_bits(), want[i].to_bits(), "sparse {w}x{h} sigma {sigma} at {i}");

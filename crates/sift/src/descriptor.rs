@@ -2,6 +2,7 @@
 //! Gaussian weighting, clipping at 0.2, renormalisation, bytes (OpenCV `calcSIFTDescriptor`).
 
 use crate::fastmath::atan2_deg;
+use crate::image::Plane;
 use crate::keypoint::DESCRIPTOR_LEN;
 
 /// Cells per side of the descriptor window.
@@ -119,23 +120,17 @@ pub struct Frame {
 
 crate::cpu_dispatch! {
     /// Computes the descriptor of Gaussian image `img` (`w` x `h`) in frame `at`.
-    pub fn descriptor(img: &[f32], w: usize, h: usize, at: Frame, out: &mut [u8], s: &mut DescScratch);
-    "avx512f" => descriptor_avx512 => descriptor_impl::<true>(img, w, h, at, out, s);
-    "avx2" => descriptor_avx2 => descriptor_impl::<false>(img, w, h, at, out, s);
-    _ => descriptor_impl::<false>(img, w, h, at, out, s)
+    pub fn descriptor(img: Plane<'_>, at: Frame, out: &mut [u8], s: &mut DescScratch);
+    "avx512f" => descriptor_avx512 => descriptor_impl::<true>(img, at, out, s);
+    "avx2" => descriptor_avx2 => descriptor_impl::<false>(img, at, out, s);
+    _ => descriptor_impl::<false>(img, at, out, s)
 }
 
 /// The descriptor; with `AVX512` (only when the caller has that target feature), the window's samples
 /// are gathered 16 columns at a time (the same values in the same order as the scalar loop).
 #[inline(always)]
-fn descriptor_impl<const AVX512: bool>(
-    img: &[f32],
-    w: usize,
-    h: usize,
-    at: Frame,
-    out: &mut [u8],
-    s: &mut DescScratch,
-) {
+fn descriptor_impl<const AVX512: bool>(img: Plane<'_>, at: Frame, out: &mut [u8], s: &mut DescScratch) {
+    let Plane { data: img, w, h } = img;
     let Frame { px, py, ori, scl } = at;
     let (ptx, pty) = (px.round_ties_even() as isize, py.round_ties_even() as isize);
     let rad = ori * (std::f32::consts::PI / 180.0);
@@ -342,8 +337,8 @@ mod tests {
             let (px, py) = (rnd() * (w as f32 - 1.0), rnd() * (h as f32 - 1.0));
             let (ori, scl) = (rnd() * 360.0, 0.8 + rnd() * 6.0);
             let (mut fast, mut slow) = ([0u8; DESCRIPTOR_LEN], [0u8; DESCRIPTOR_LEN]);
-            descriptor(&img, w, h, Frame { px, py, ori, scl }, &mut fast, &mut a);
-            descriptor_impl::<false>(&img, w, h, Frame { px, py, ori, scl }, &mut slow, &mut b);
+            descriptor(Plane::new(&img, w, h), Frame { px, py, ori, scl }, &mut fast, &mut a);
+            descriptor_impl::<false>(Plane::new(&img, w, h), Frame { px, py, ori, scl }, &mut slow, &mut b);
             assert_eq!(fast, slow, "at ({px}, {py}), angle {ori}, scale {scl}");
         }
     }
@@ -353,19 +348,27 @@ mod tests {
         let (w, h) = (64, 64);
         let img: Vec<f32> = (0..w * h).map(|i| ((i % w) as f32 * 0.3).sin() * 50.0 + (i / w) as f32).collect();
         let mut d = [0u8; DESCRIPTOR_LEN];
-        descriptor(&img, w, h, Frame { px: 32.0, py: 32.0, ori: 0.0, scl: 3.0 }, &mut d, &mut DescScratch::default());
+        descriptor(
+            Plane::new(&img, w, h),
+            Frame { px: 32.0, py: 32.0, ori: 0.0, scl: 3.0 },
+            &mut d,
+            &mut DescScratch::default(),
+        );
         let n: f32 = d.iter().map(|&v| (v as f32) * (v as f32)).sum::<f32>().sqrt();
         assert!((n - 512.0).abs() < 20.0, "{n}");
         // Transposed image with orientation turned by 90 degrees gives a permuted, similar descriptor.
         let t: Vec<f32> = (0..w * h).map(|i| img[(i % w) * w + i / w]).collect();
         let mut d2 = [0u8; DESCRIPTOR_LEN];
-        descriptor(&t, w, h, Frame { px: 32.0, py: 32.0, ori: 0.0, scl: 3.0 }, &mut d2, &mut DescScratch::default());
+        descriptor(
+            Plane::new(&t, w, h),
+            Frame { px: 32.0, py: 32.0, ori: 0.0, scl: 3.0 },
+            &mut d2,
+            &mut DescScratch::default(),
+        );
         assert_ne!(d, d2);
         let mut empty = [7u8; DESCRIPTOR_LEN];
         descriptor(
-            &[1.0; 9],
-            3,
-            3,
+            Plane::new(&[1.0; 9], 3, 3),
             Frame { px: 1.0, py: 1.0, ori: 0.0, scl: 1.0 },
             &mut empty,
             &mut DescScratch::default(),

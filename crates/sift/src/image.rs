@@ -5,6 +5,26 @@ use crate::error::SiftError;
 /// Largest side accepted (the doubled image must stay addressable): 2^24 pixels.
 const MAX_SIDE: usize = 1 << 24;
 
+/// A borrowed view of a row-major f32 image (a pyramid layer, a DoG layer): its pixels and size, passed as one
+/// argument where functions took `(data, w, h, ...)`.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Plane<'a> {
+    /// The pixels, row-major; at least `w * h` of them.
+    pub data: &'a [f32],
+    /// Width, pixels.
+    pub w: usize,
+    /// Height, pixels.
+    pub h: usize,
+}
+
+impl<'a> Plane<'a> {
+    /// The view of `data` as a `w` x `h` image.
+    #[inline]
+    pub fn new(data: &'a [f32], w: usize, h: usize) -> Self {
+        Plane { data, w, h }
+    }
+}
+
 /// A grey image, row-major, values on the 8-bit scale 0..255 (like OpenCV's `CV_8U` input).
 #[derive(Debug, Clone, PartialEq)]
 pub struct GrayImage {

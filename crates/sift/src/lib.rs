@@ -38,6 +38,7 @@ pub use params::SiftParams;
 
 use descriptor::DescScratch;
 use extrema::{Candidate, DogRows, DogView, find_candidates, refine};
+use image::Plane;
 use orientation::{ORI_HIST_BINS, ORI_RADIUS, ORI_SIG_FCTR, OriScratch, orientation_hist, peak_angles};
 use pyramid::Octave;
 use rayon::prelude::*;
@@ -245,9 +246,7 @@ fn process_candidate(
     let gauss = oct.layer(rf.layer);
     let mut hist = [0.0f32; ORI_HIST_BINS];
     let omax = orientation_hist(
-        gauss,
-        w,
-        h,
+        Plane::new(gauss, w, h),
         rf.c,
         rf.r,
         (ORI_RADIUS * scl_octv).round_ties_even() as i32,
@@ -266,7 +265,7 @@ fn process_candidate(
         }
         let mut d = [0u8; DESCRIPTOR_LEN];
         let at = descriptor::Frame { px, py, ori: d_angle, scl: scl_octv };
-        descriptor::descriptor(gauss, w, h, at, &mut d, desc);
+        descriptor::descriptor(Plane::new(gauss, w, h), at, &mut d, desc);
         out.push((kp, d));
     }
 }

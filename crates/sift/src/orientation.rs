@@ -2,6 +2,7 @@
 //! maximum with parabolic interpolation (OpenCV `calcOrientationHist` and its caller).
 
 use crate::fastmath::{atan2_deg, round_i32};
+use crate::image::Plane;
 
 /// Histogram bins.
 pub const ORI_HIST_BINS: usize = 36;
@@ -24,11 +25,8 @@ pub struct OriScratch {
 crate::cpu_dispatch! {
     /// Smoothed orientation histogram around integer pixel (`x`, `y`) of Gaussian image `img` (`w` x `h`);
     /// returns its maximum.
-    #[allow(clippy::too_many_arguments)]
     pub fn orientation_hist(
-        img: &[f32],
-        w: usize,
-        h: usize,
+        img: Plane<'_>,
         x: usize,
         y: usize,
         radius: i32,
@@ -36,16 +34,13 @@ crate::cpu_dispatch! {
         hist: &mut [f32; ORI_HIST_BINS],
         s: &mut OriScratch,
     ) -> f32;
-    "avx2" => orientation_hist_avx2 => orientation_hist_impl(img, w, h, x, y, radius, sigma, hist, s);
-    _ => orientation_hist_impl(img, w, h, x, y, radius, sigma, hist, s)
+    "avx2" => orientation_hist_avx2 => orientation_hist_impl(img, x, y, radius, sigma, hist, s);
+    _ => orientation_hist_impl(img, x, y, radius, sigma, hist, s)
 }
 
 #[inline(always)]
-#[allow(clippy::too_many_arguments)]
 fn orientation_hist_impl(
-    img: &[f32],
-    w: usize,
-    h: usize,
+    img: Plane<'_>,
     x: usize,
     y: usize,
     radius: i32,
@@ -53,6 +48,7 @@ fn orientation_hist_impl(
     hist: &mut [f32; ORI_HIST_BINS],
     s: &mut OriScratch,
 ) -> f32 {
+    let Plane { data: img, w, h } = img;
     let n = ORI_HIST_BINS;
     let expf_scale = -1.0 / (2.0 * sigma * sigma);
     let radius = radius.max(0) as isize;
@@ -149,14 +145,14 @@ mod tests {
         let (w, h) = (32, 32);
         let img: Vec<f32> = (0..w * h).map(|i| (i % w) as f32 * 3.0).collect();
         let mut hist = [0.0; ORI_HIST_BINS];
-        let max = orientation_hist(&img, w, h, 16, 16, 6, 2.0, &mut hist, &mut OriScratch::default());
+        let max = orientation_hist(Plane::new(&img, w, h), 16, 16, 6, 2.0, &mut hist, &mut OriScratch::default());
         let mut angles = Vec::new();
         peak_angles(&hist, max, &mut angles);
         assert_eq!(angles.len(), 1);
         assert!(angles[0] < 1.0 || angles[0] > 359.0, "{angles:?}");
         // Intensity increasing downwards: dy = img[y-1] - img[y+1] < 0, atan -> 270, keypoint angle 90.
         let img: Vec<f32> = (0..w * h).map(|i| (i / w) as f32 * 3.0).collect();
-        let max = orientation_hist(&img, w, h, 16, 16, 6, 2.0, &mut hist, &mut OriScratch::default());
+        let max = orientation_hist(Plane::new(&img, w, h), 16, 16, 6, 2.0, &mut hist, &mut OriScratch::default());
         angles.clear();
         peak_angles(&hist, max, &mut angles);
         assert_eq!(angles.len(), 1);

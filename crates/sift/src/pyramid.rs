@@ -5,6 +5,7 @@
 //! difference of two Gaussian layers, formed where it is needed (see `extrema`).
 
 use crate::blur::{BlurScratch, Kernel, Sparse, blur, blur_band};
+use crate::image::Plane;
 use crate::mask::{BitMask, ChunkMask, Flat};
 use crate::params::SiftParams;
 
@@ -220,9 +221,9 @@ impl Octave {
             let (mut vert, mut out) = (ChunkMask::default(), ChunkMask::default());
             grow(&mut self.tmp, &mut self.level, kernel.radius(), &mut vert, &mut out);
             let sp = Sparse { vert: &vert, out: &out };
-            blur(&self.spare, base, bw, bh, &kernel, &mut self.scratch, params.parallel, Some(sp));
+            blur(Plane::new(&self.spare, bw, bh), base, &kernel, &mut self.scratch, params.parallel, Some(sp));
         } else {
-            blur(&self.spare, base, bw, bh, &kernel, &mut self.scratch, params.parallel, None);
+            blur(Plane::new(&self.spare, bw, bh), base, &kernel, &mut self.scratch, params.parallel, None);
         }
         self.base_kernel = kernel;
     }
@@ -314,7 +315,7 @@ impl Octave {
             let dst = &mut rest[0];
             ensure_len(dst, n);
             let sp = self.masked.then(|| Sparse { vert: &self.vert[i], out: &self.out[i] });
-            blur(&done[i - 1], dst, self.w, self.h, &self.kernels[i], &mut self.scratch, parallel, sp);
+            blur(Plane::new(&done[i - 1], self.w, self.h), dst, &self.kernels[i], &mut self.scratch, parallel, sp);
         }
     }
 
@@ -342,7 +343,7 @@ impl Octave {
                     let (done, rest) = self.gauss.split_at_mut(i);
                     let sp = self.masked.then(|| Sparse { vert: &self.vert[i], out: &self.out[i] });
                     let k = &self.kernels[i];
-                    blur_band(&done[i - 1], &mut rest[0], w, h, avail[i], target, k, &mut self.scratch, sp);
+                    blur_band(Plane::new(&done[i - 1], w, h), &mut rest[0], avail[i], target, k, &mut self.scratch, sp);
                     avail[i] = target;
                 }
             }
