@@ -20,7 +20,7 @@
 //! ([`OdometrySource`]); every repair is counted ([`Repairs`]). A step back of more than
 //! [`ReadOptions::max_step_back`] is refused, naming the line.
 
-use crate::pose::{Pose2, interpolate, pose};
+use crate::{pose::interpolate, se2::{Pose2, pose}};
 use crate::scan::{LaserScan, Odometry};
 use std::collections::BTreeMap;
 use std::io::{BufRead, BufReader, Read};
@@ -540,7 +540,7 @@ fn parse_robot_laser(f: &[&str], line: usize) -> Result<ScanRecord, String> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::pose::Xyt;
+    use crate::se2::Xyt;
 
     const LOG: &str = "\
 # CARMEN Logfile

@@ -6,7 +6,7 @@
 
 use crate::estimate::Model;
 use crate::estimate::fit;
-use mrslam_core::grid::floor_i64;
+use mrslam_core::floor_i64;
 use mrslam_core::{CellState, OccupancyGrid, Pose2, pose};
 use nalgebra::Point2;
 

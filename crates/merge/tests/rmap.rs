@@ -4,7 +4,7 @@
 use mrslam_core::{CellState, OccupancyGrid, Pose2, pose};
 use mrslam_merge::floorplan::{FloorplanParams, generate};
 use mrslam_merge::pairs::{MapPair, PairSpec, cut_pair, cut_pair_quarter};
-use mrslam_merge::rmap::{CoverRule, FreeMatrix, Mer, mers};
+use mrslam_merge::dev::{CoverRule, FreeMatrix, Mer, mers};
 use mrslam_merge::{MergeParams, RmapMerger, merge};
 use proptest::prelude::*;
 use rayon::prelude::*;

@@ -1,6 +1,6 @@
 //! The odometry motion model: GMapping's `MotionModel::drawFromMotion`.
 
-use mrslam_core::pose::{Pose2, Xyt, normalize_angle, pose, relative};
+use mrslam_core::{Pose2, Xyt, pose, pose::{normalize_angle, relative}};
 use rand::Rng;
 use rand_distr::StandardNormal;
 

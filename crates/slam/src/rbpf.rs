@@ -9,7 +9,7 @@ use crate::particle::{Particle, TrajectoryNode, ancestry};
 use crate::resample::{normalize, systematic};
 use crate::scan_matcher::{MatchResult, MotionPrior, PreparedScan, ScanMatcher, Scratch};
 use crate::scan_odometry::ScanOdometry;
-use mrslam_core::pose::{Xyt, relative};
+use mrslam_core::{Xyt, pose::relative};
 use mrslam_core::{LaserScan, OccupancyGrid, Odometry, Pose2};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;

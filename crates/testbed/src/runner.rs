@@ -10,7 +10,7 @@ use mrslam_merge::{
     Algorithm, CorrelativeMerger, MatchParams, MergeOutcome, MergeParams, Merger, RmapMerger, RmapParams, SiftMerger,
     SiftMergerParams, merge,
 };
-use mrslam_sim::geometry::Obstacle;
+use mrslam_sim::Obstacle;
 use mrslam_sim::{RobotId, Sim, SimConfig, SimError, StepEvents};
 use mrslam_slam::{Rbpf, SlamError};
 use mrslam_viz::{MergeView, RobotInfo, RunRecorder, SlamState};

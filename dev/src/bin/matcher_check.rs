@@ -2,10 +2,10 @@
 #![allow(clippy::unwrap_used, reason = "a development aid / test: a failed unwrap names the problem")]
 
 use mrslam_core::pose;
-use mrslam_core::pose::Xyt;
-use mrslam_slam::scan_matcher::{PreparedScan, ScanMatcher};
+use mrslam_core::Xyt;
+use mrslam_slam::dev::{PreparedScan, ScanMatcher};
 use mrslam_slam::synthetic::{self, Drift, Lidar};
-use mrslam_slam::tile_map::TileMap;
+use mrslam_slam::dev::TileMap;
 
 fn main() {
     let env = |k: &str, d: f64| std::env::var(k).ok().and_then(|v| v.parse().ok()).unwrap_or(d);
