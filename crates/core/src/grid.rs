@@ -1,8 +1,8 @@
 //! The log-odds occupancy grid: storage, frames, scan integration and ray casting.
 
-use crate::se2::Pose2;
 use crate::raycast::CellTraversal;
 use crate::scan::LaserScan;
+use crate::se2::Pose2;
 use nalgebra::Point2;
 
 /// Cells scanned together when looking for a known one (a vectorised test, then the exact position).

@@ -40,16 +40,16 @@ pub use merger::{Alignment, Evidence, MergeOutcome, MergeParams, Merger, NoAlign
 pub use multi::{MultiOutcome, MultiReport, PairReport, TreeEdge, merge_many};
 pub use refine::RefineParams;
 pub use report::MergeReport;
-pub use rmap::{RmapMerger, RmapParams};
+pub use rmap::{CoverRule, OrientParams, RmapMerger, RmapParams, RmapResult, TriangleMatch, TriangleParams};
 pub use sift_merger::{SiftMerger, SiftMergerParams};
-pub use verify::{VerifyParams, agreement};
+pub use verify::{Agreement, VerifyParams, agreement};
 
 /// Internals public only for the crate's tests and benches and the development probes (`dev/` in the
 /// repository): the R-map's maximal empty rectangles, wall ICP, wall hits, descriptor matching. Not part of
 /// the crate's API.
 pub mod dev {
-    pub use crate::matching::match_features;
+    pub use crate::matching::{Match, match_features};
     pub use crate::refine::{refine, wall_points};
-    pub use crate::rmap::{CoverRule, FreeMatrix, Mer, mers};
+    pub use crate::rmap::{FreeMatrix, Mer, mers};
     pub use crate::verify::wall_hits;
 }

@@ -1,6 +1,9 @@
 //! The odometry motion model: GMapping's `MotionModel::drawFromMotion`.
 
-use mrslam_core::{Pose2, Xyt, pose, pose::{normalize_angle, relative}};
+use mrslam_core::{
+    Pose2, Xyt, pose,
+    pose::{normalize_angle, relative},
+};
 use rand::Rng;
 use rand_distr::StandardNormal;
 

@@ -67,6 +67,7 @@ impl Tile {
 
 /// A grid of hit statistics made of copy-on-write tiles.
 #[derive(Clone)]
+/// Public (through the crate's `dev` module) only for the tests, benches and development probes.
 pub struct TileMap {
     delta: f64,
     inv_delta: f64,

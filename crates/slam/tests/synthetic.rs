@@ -1,8 +1,8 @@
 //! End-to-end: the filter on synthetic data with a known map, path and drifting odometry.
 #![allow(clippy::unwrap_used, reason = "a development aid / test: a failed unwrap names the problem")]
 
-use mrslam_core::{Xyt, pose::relative};
 use mrslam_core::{CellState, OccupancyGrid, Odometry, Pose2, pose};
+use mrslam_core::{Xyt, pose::relative};
 use mrslam_slam::synthetic::{self, Drift, Lidar, SyntheticRun};
 use mrslam_slam::{Rbpf, SlamParams, UpdateOutcome};
 

@@ -4,12 +4,15 @@
 //! `cargo run --release -p mrslam-dev --bin matcher_lab -- [hokuyo|rplidar] [name=value ...]`
 #![allow(clippy::unwrap_used, reason = "a development aid / test: a failed unwrap names the problem")]
 
-use mrslam_core::pose;
 use mrslam_core::Xyt;
+use mrslam_core::pose;
 use mrslam_slam::SlamParams;
-use mrslam_slam::{MatcherKind, dev::{PreparedScan, ScanMatcher}};
-use mrslam_slam::synthetic::{self, Drift, Lidar};
 use mrslam_slam::dev::TileMap;
+use mrslam_slam::synthetic::{self, Drift, Lidar};
+use mrslam_slam::{
+    MatcherKind,
+    dev::{PreparedScan, ScanMatcher},
+};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};

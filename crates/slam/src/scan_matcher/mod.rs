@@ -93,6 +93,7 @@ impl Beam {
 
 /// A scan prepared for matching and mapping.
 #[derive(Debug, Clone, Default)]
+/// Public (through the crate's `dev` module) only for the tests, benches and development probes.
 pub struct PreparedScan {
     /// Beams the matcher uses: valid, within the usable range, every (lskip+1)-th.
     pub matched: Vec<Beam>,
@@ -131,6 +132,7 @@ impl PreparedScan {
 
 /// The scan matcher's settings (see [`crate::SlamParams`] for each).
 #[derive(Debug, Clone, Copy, PartialEq)]
+/// Public (through the crate's `dev` module) only for the tests, benches and development probes.
 pub struct ScanMatcher {
     /// Laser mount pose on the robot.
     pub laser: Xyt,
@@ -233,6 +235,7 @@ impl PosePrior {
 
 /// Per-thread working memory of the matcher (the likelihood field), reused between particles.
 #[derive(Debug, Clone, Default)]
+/// Public (through the crate's `dev` module) only for the tests, benches and development probes.
 pub struct Scratch {
     /// The field of the particle being matched.
     pub field: Field,
