@@ -24,7 +24,8 @@ pub use carmen::{
     CarmenError, CarmenLog, LaserSource, MAX_STEP_BACK, OdometrySource, ReadOptions, Repairs, ScanRecord,
 };
 pub use grid::{
-    CellState, FREE_LOGODDS, GridError, LogOddsParams, MAX_CELLS, OCCUPIED_LOGODDS, OccupancyGrid, floor_i64,
+    CellState, FREE_LOGODDS, GridError, LogOddsParams, MAX_CELLS, OCCUPIED_LOGODDS, OccupancyGrid, floor_i64, log_odds,
+    probability,
 };
 pub use raycast::CellTraversal;
 pub use scan::{LaserScan, Odometry};

@@ -3,7 +3,7 @@
 
 use crate::se2::{Pose2, Xyt, pose};
 
-use nalgebra::{Isometry2, Point2, Vector2};
+use nalgebra::Point2;
 use std::f64::consts::PI;
 
 /// Composes `a ⊕ b`: the pose `b`, expressed in frame `a`, taken to `a`'s parent frame.
