@@ -1,9 +1,8 @@
 //! The odometry motion model: GMapping's `MotionModel::drawFromMotion`.
 
-use mrslam_core::{
-    Pose2, Xyt, pose,
-    pose::{normalize_angle, relative},
-};
+use mrslam_core::{Pose2, pose, pose::normalize_angle};
+#[cfg(test)]
+use mrslam_core::{Xyt, pose::relative};
 use rand::Rng;
 use rand_distr::StandardNormal;
 
