@@ -4,7 +4,7 @@ use anyhow::{Context, Result, bail};
 use clap::Args;
 use mrslam_core::map_io::{self, write_file_atomic};
 use mrslam_merge::MapEncoding;
-use mrslam_merge::map_image::MapImage;
+use mrslam_merge::MapImage;
 use mrslam_sift::{Features, GrayImage, Sift, SiftParams};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;

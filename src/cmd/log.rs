@@ -2,7 +2,7 @@
 
 use anyhow::Result;
 use clap::{Args, Subcommand};
-use mrslam_core::carmen::MAX_STEP_BACK;
+use mrslam_core::MAX_STEP_BACK;
 use mrslam_core::{CarmenLog, OdometrySource, ReadOptions};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;

@@ -3,8 +3,8 @@
 use super::paths::{self, extension};
 use anyhow::{Context, Result, bail};
 use clap::Subcommand;
+use mrslam_core::Xyt;
 use mrslam_core::map_io::{self, GreyImage, MapMode, MapYaml};
-use mrslam_core::pose::Xyt;
 use mrslam_core::{OccupancyGrid, map_io::grid_from_image};
 use mrslam_merge::pairs::{PairSpec, cut_pair};
 use std::path::{Path, PathBuf};

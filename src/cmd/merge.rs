@@ -5,7 +5,7 @@ use clap::Args;
 use clap::builder::{PossibleValuesParser, TypedValueParser};
 use mrslam_core::OccupancyGrid;
 use mrslam_core::map_io::{self, write_file_atomic};
-use mrslam_merge::map_image::MapImage;
+use mrslam_merge::MapImage;
 use mrslam_merge::{
     Algorithm, CorrelativeMerger, Evidence, FusionRule, MapEncoding, MatchParams, MergeParams, MergeReport, Merger,
     Model, RmapMerger, RmapParams, SiftMerger, SiftMergerParams, merge,

@@ -100,7 +100,7 @@ pub fn run(args: RunArgs) -> Result<ExitCode> {
 fn remove_stale_recordings(dir: &Path, keep: Option<&Path>) -> Result<()> {
     let kept: Vec<PathBuf> = keep
         .into_iter()
-        .flat_map(|k| [k.to_path_buf(), mrslam_viz::target::partial_path(k)])
+        .flat_map(|k| [k.to_path_buf(), mrslam_viz::partial_path(k)])
         .filter_map(|k| k.canonicalize().ok())
         .collect();
     let entries = std::fs::read_dir(dir).map_err(|e| anyhow::anyhow!("{}: {e}", dir.display()))?;

@@ -16,7 +16,7 @@ pub struct VizArgs {
     pub spawn: bool,
     /// Stream to a running rerun viewer at ADDR (HOST:PORT or rerun+http://HOST:PORT/proxy;
     /// default 127.0.0.1:9876).
-    #[arg(long, value_name = "ADDR", num_args = 0..=1, default_missing_value = mrslam_viz::target::DEFAULT_CONNECT)]
+    #[arg(long, value_name = "ADDR", num_args = 0..=1, default_missing_value = mrslam_viz::DEFAULT_CONNECT)]
     pub connect: Option<String>,
 }
 

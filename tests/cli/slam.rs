@@ -3,7 +3,7 @@
 
 use crate::util::{mrslam, text};
 use mrslam_core::Pose2;
-use mrslam_core::pose::{Xyt, relative};
+use mrslam_core::{Xyt, pose::relative};
 use mrslam_slam::synthetic::{self, Drift, Lidar, SyntheticRun};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};

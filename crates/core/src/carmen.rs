@@ -20,8 +20,11 @@
 //! ([`OdometrySource`]); every repair is counted ([`Repairs`]). A step back of more than
 //! [`ReadOptions::max_step_back`] is refused, naming the line.
 
-use crate::pose::{Pose2, interpolate, pose};
 use crate::scan::{LaserScan, Odometry};
+use crate::{
+    pose::interpolate,
+    se2::{Pose2, pose},
+};
 use std::collections::BTreeMap;
 use std::io::{BufRead, BufReader, Read};
 use std::path::{Path, PathBuf};
@@ -540,7 +543,7 @@ fn parse_robot_laser(f: &[&str], line: usize) -> Result<ScanRecord, String> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::pose::Xyt;
+    use crate::se2::Xyt;
 
     const LOG: &str = "\
 # CARMEN Logfile

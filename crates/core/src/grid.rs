@@ -1,8 +1,8 @@
 //! The log-odds occupancy grid: storage, frames, scan integration and ray casting.
 
-use crate::pose::Pose2;
 use crate::raycast::CellTraversal;
 use crate::scan::LaserScan;
+use crate::se2::Pose2;
 use nalgebra::Point2;
 
 /// Cells scanned together when looking for a known one (a vectorised test, then the exact position).
@@ -503,7 +503,7 @@ mod tests {
             assert_eq!(floor_i64(x), x.floor() as i64, "{x}");
         }
     }
-    use crate::pose::pose;
+    use crate::se2::pose;
     use proptest::prelude::*;
     use std::f64::consts::PI;
 

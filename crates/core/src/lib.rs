@@ -4,21 +4,30 @@
 //! [`OccupancyGrid`] with ray traversal and ray casting, ROS map_server map I/O, CARMEN log reading, and the benchmark metric on relations (Kümmerle et al. 2009).
 //! Units are SI (metres, radians, seconds) everywhere.
 
-pub mod carmen;
-pub mod grid;
+#![deny(missing_docs)]
+
+// Private modules, their user-facing items re-exported below; `input`, `map_io`, `pose`, `relations` and
+// `toml_lines` are public namespaces of functions (`map_io::read_ros_map`, `pose::normalize_angle`,
+// `relations::score`), their items not re-exported.
+mod carmen;
+mod grid;
 pub mod input;
 pub mod map_io;
 pub mod pose;
-pub mod raycast;
+mod raycast;
 pub mod relations;
-pub mod scan;
+mod scan;
+mod se2;
 pub mod sensor;
 pub mod toml_lines;
 
-pub use carmen::{CarmenError, CarmenLog, LaserSource, OdometrySource, ReadOptions, Repairs, ScanRecord};
-pub use grid::{CellState, GridError, LogOddsParams, OccupancyGrid};
-pub use map_io::{MapIoError, MapMode, MapYaml};
-pub use pose::{Pose2, Xyt, pose};
+pub use carmen::{
+    CarmenError, CarmenLog, LaserSource, MAX_STEP_BACK, OdometrySource, ReadOptions, Repairs, ScanRecord,
+};
+pub use grid::{
+    CellState, FREE_LOGODDS, GridError, LogOddsParams, MAX_CELLS, OCCUPIED_LOGODDS, OccupancyGrid, floor_i64, log_odds,
+    probability,
+};
 pub use raycast::CellTraversal;
-pub use relations::{Relation, RelationsError, RelationsScore, StampedPose};
 pub use scan::{LaserScan, Odometry};
+pub use se2::{Pose2, Xyt, pose};

@@ -11,7 +11,7 @@
 //! and the field.
 
 use crate::grid::{CellState, GridError, MAX_CELLS, OccupancyGrid};
-use crate::pose::{Pose2, pose};
+use crate::se2::{Pose2, pose};
 use std::fmt::Write as _;
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
@@ -630,7 +630,7 @@ mod tests {
         let back = read_ros_map(&p).unwrap();
         assert_eq!(back.cells(), g.cells());
         assert_eq!((back.width(), back.height()), (7, 5));
-        let crate::pose::Xyt { x, y, theta: t } = crate::pose::Xyt::from_pose(back.origin());
+        let crate::se2::Xyt { x, y, theta: t } = crate::se2::Xyt::from_pose(back.origin());
         assert!((x + 1.0).abs() < 1e-12 && (y - 2.5).abs() < 1e-12 && (t - 0.25).abs() < 1e-12);
         assert!(dir.path().join("map.pgm").exists());
         // no temporary files left behind

@@ -9,7 +9,10 @@
 //!
 //! A trajectory file holds one pose a line, `stamp x y theta`, `#` starting a comment.
 
-use crate::pose::{Pose2, Xyt, normalize_angle, pose};
+use crate::{
+    pose::normalize_angle,
+    se2::{Pose2, Xyt, pose},
+};
 use std::path::{Path, PathBuf};
 
 /// One relation of a relations file.

@@ -1,6 +1,6 @@
 //! Laser scans and odometry readings, as a robot's drivers deliver them.
 
-use crate::pose::Pose2;
+use crate::se2::Pose2;
 use nalgebra::Point2;
 
 /// One planar laser scan, laid out as ROS's `sensor_msgs/LaserScan`.
@@ -82,7 +82,7 @@ pub struct Odometry {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::pose::pose;
+    use crate::se2::pose;
 
     fn scan(ranges: Vec<f32>) -> LaserScan {
         LaserScan {

@@ -3,9 +3,10 @@
 #![allow(missing_docs, reason = "criterion_group! defines an undocumented public function")]
 
 use criterion::{Criterion, criterion_group, criterion_main};
+use mrslam_merge::CoverRule;
+use mrslam_merge::dev::{FreeMatrix, mers};
 use mrslam_merge::floorplan::{FloorplanParams, generate};
 use mrslam_merge::pairs::{PairSpec, cut_pair_quarter};
-use mrslam_merge::rmap::{CoverRule, FreeMatrix, mers};
 use mrslam_merge::{MergeParams, Merger, RmapMerger, SiftMerger, merge};
 use std::hint::black_box;
 

@@ -1,7 +1,7 @@
 //! Fusion: one grid in map a's frame holding both maps (paper Alg. 3, line 8).
 
 use crate::resample::{GridGeometry, covering_geometry, known_corners};
-use mrslam_core::grid::floor_i64;
+use mrslam_core::floor_i64;
 use mrslam_core::{CellState, OccupancyGrid, Pose2};
 use nalgebra::Point2;
 

@@ -2,38 +2,54 @@
 //!
 //! The paper's SIFT merger ([`SiftMerger`], Algorithm 3), its R-map baseline ([`RmapMerger`], Algorithm 1)
 //! and a global correlative search ([`CorrelativeMerger`]) behind the [`Merger`] interface, named by [`Algorithm`], a verification
-//! gate that rejects merges the maps themselves contradict ([`verify`]), fusion into one grid ([`fuse`]),
-//! N maps at once along a spanning tree of the most confident pairs ([`multi`]),
+//! gate that rejects merges the maps themselves contradict (`verify`), fusion into one grid (`fuse`),
+//! N maps at once along a spanning tree of the most confident pairs (`multi`),
 //! and the generators evaluation needs: procedural floor plans ([`floorplan`]) and map pairs cut with a
 //! known overlap and a known transform ([`pairs`]).
+//!
+//! Modules are private and their items re-exported here, except the public namespaces [`floorplan`],
+//! [`pairs`] and [`resample`]; [`dev`] holds internals public only for tests, benches and the development
+//! probes.
+
+#![deny(missing_docs)]
 
 mod algorithm;
-pub mod correlative;
-pub mod estimate;
+mod correlative;
+mod estimate;
 pub mod floorplan;
-pub mod fuse;
-pub mod map_image;
-pub mod matching;
-pub mod merger;
-pub mod multi;
+mod fuse;
+mod map_image;
+mod matching;
+mod merger;
+mod multi;
 pub mod pairs;
-pub mod refine;
-pub mod report;
+mod refine;
+mod report;
 pub mod resample;
-pub mod rmap;
-pub mod sift_merger;
-pub mod verify;
+mod rmap;
+mod sift_merger;
+mod verify;
 
 pub use algorithm::{Algorithm, UnknownAlgorithm};
 pub use correlative::{CorrelativeMerger, CorrelativeParams};
 pub use estimate::{Model, RansacParams};
 pub use fuse::FusionRule;
-pub use map_image::MapEncoding;
+pub use map_image::{MapEncoding, MapImage};
 pub use matching::MatchParams;
 pub use merger::{Alignment, Evidence, MergeOutcome, MergeParams, Merger, NoAlignment, merge};
 pub use multi::{MultiOutcome, MultiReport, PairReport, TreeEdge, merge_many};
 pub use refine::RefineParams;
 pub use report::MergeReport;
-pub use rmap::{RmapMerger, RmapParams};
+pub use rmap::{CoverRule, OrientParams, RmapMerger, RmapParams, RmapResult, TriangleMatch, TriangleParams};
 pub use sift_merger::{SiftMerger, SiftMergerParams};
-pub use verify::VerifyParams;
+pub use verify::{Agreement, VerifyParams, agreement};
+
+/// Internals public only for the crate's tests and benches and the development probes (`dev/` in the
+/// repository): the R-map's maximal empty rectangles, wall ICP, wall hits, descriptor matching. Not part of
+/// the crate's API.
+pub mod dev {
+    pub use crate::matching::{Match, match_features};
+    pub use crate::refine::{refine, wall_points};
+    pub use crate::rmap::{FreeMatrix, Mer, mers};
+    pub use crate::verify::wall_hits;
+}

@@ -1,7 +1,7 @@
 //! Map → image: how occupied, free and unknown cells become grey levels for SIFT (paper Alg. 3, lines 2-3).
 
-use mrslam_core::grid::{FREE_LOGODDS, OCCUPIED_LOGODDS};
 use mrslam_core::{CellState, OccupancyGrid};
+use mrslam_core::{FREE_LOGODDS, OCCUPIED_LOGODDS};
 use nalgebra::Point2;
 
 /// Grey levels (0..255) given to each cell state when a map becomes an image.

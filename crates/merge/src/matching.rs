@@ -5,6 +5,7 @@ use rayon::prelude::*;
 
 /// A correspondence between feature `a` of the first set and feature `b` of the second.
 #[derive(Debug, Clone, Copy, PartialEq)]
+/// Public (through the crate's `dev` module) only for the tests, benches and development probes.
 pub struct Match {
     /// Index in the first feature set.
     pub a: usize,
@@ -103,6 +104,7 @@ fn k_nearest_impl(q: &[u8], set: &[u8], k: usize, out: &mut Vec<(usize, u32)>) {
 /// `candidates` > 1, to its k nearest neighbours.
 ///
 /// Results are ordered by index in `a` (then by distance), so they do not depend on thread scheduling.
+/// Public (through the crate's `dev` module) only for the tests, benches and development probes.
 pub fn match_features(a: &Features, b: &Features, p: &MatchParams) -> Vec<Match> {
     if a.is_empty() || b.len() < 2 {
         return Vec::new();

@@ -6,7 +6,7 @@
 
 use crate::estimate::Model;
 use crate::estimate::fit;
-use mrslam_core::grid::floor_i64;
+use mrslam_core::floor_i64;
 use mrslam_core::{CellState, OccupancyGrid, Pose2, pose};
 use nalgebra::Point2;
 
@@ -35,6 +35,7 @@ impl Default for RefineParams {
 }
 
 /// Occupied cell centres of a grid, in its map frame.
+/// Public (through the crate's `dev` module) only for the tests, benches and development probes.
 pub fn wall_points(g: &OccupancyGrid) -> Vec<Point2<f64>> {
     (0..g.height())
         .flat_map(|iy| (0..g.width()).map(move |ix| (ix, iy)))
@@ -44,6 +45,7 @@ pub fn wall_points(g: &OccupancyGrid) -> Vec<Point2<f64>> {
 }
 
 /// Refines `t_a_b` by ICP of b's walls onto a's walls; returns the input unchanged when too few pairs form.
+/// Public (through the crate's `dev` module) only for the tests, benches and development probes.
 pub fn refine(a: &OccupancyGrid, walls_b: &[Point2<f64>], t_a_b: &Pose2, p: &RefineParams) -> Pose2 {
     let mut t = *t_a_b;
     if !p.enabled {

@@ -1,6 +1,6 @@
 //! Resampling a grid into another frame or resolution (nearest neighbour, states kept sharp).
 
-use mrslam_core::grid::floor_i64;
+use mrslam_core::floor_i64;
 use mrslam_core::{OccupancyGrid, Pose2, pose};
 use nalgebra::Point2;
 

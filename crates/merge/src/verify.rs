@@ -174,6 +174,7 @@ impl WallIndex {
 
 /// Walls of `b` (occupied cell centres, b's frame) placed by `t_a_b`: how many land on a's known cells, and
 /// how many of those have an occupied cell of `a` within one cell.
+/// Public (through the crate's `dev` module) only for the tests, benches and development probes.
 pub fn wall_hits(a: &OccupancyGrid, walls_b: &[Point2<f64>], t_a_b: &Pose2) -> (usize, usize) {
     WallIndex::of(a).hits(a, walls_b, t_a_b)
 }

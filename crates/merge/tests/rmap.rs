@@ -2,9 +2,10 @@
 //! transforms of generated floor-plan pairs, and it refuses maps it cannot work on with a reason.
 
 use mrslam_core::{CellState, OccupancyGrid, Pose2, pose};
+use mrslam_merge::CoverRule;
+use mrslam_merge::dev::{FreeMatrix, Mer, mers};
 use mrslam_merge::floorplan::{FloorplanParams, generate};
 use mrslam_merge::pairs::{MapPair, PairSpec, cut_pair, cut_pair_quarter};
-use mrslam_merge::rmap::{CoverRule, FreeMatrix, Mer, mers};
 use mrslam_merge::{MergeParams, RmapMerger, merge};
 use proptest::prelude::*;
 use rayon::prelude::*;

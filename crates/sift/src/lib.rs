@@ -12,7 +12,7 @@
 //! assert_eq!(f.len(), 0); // a flat image has no keypoint
 //! ```
 
-#![warn(missing_docs)]
+#![deny(missing_docs)]
 
 mod blur;
 mod descriptor;

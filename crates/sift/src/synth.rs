@@ -1,5 +1,5 @@
 //! Deterministic synthetic test images and the tests' random numbers: a `#[cfg(test)]` module of the library
-//! for its unit tests; the integration tests (`tests/common`), the bench and the `gen_images` example include
+//! for its unit tests; the integration tests (`tests/common`), the bench and the `gen_images` dev probe (`dev/`) include
 //! this same file, so every test draws the same sequences.
 #![allow(dead_code)]
 

@@ -8,14 +8,14 @@ here="$(cd "$(dirname "$0")" && pwd)"
 root="$(cd "$here/../../.." && pwd)"
 export CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-$root/target}"
 dir="$(mktemp -d)"
-(cd "$root" && cargo build -q -p mrslam-sift --release --examples)
-"$CARGO_TARGET_DIR/release/examples/gen_images" "$dir" > /dev/null
+(cd "$root" && cargo build -q --release -p mrslam-dev --bin gen_images --bin sift_json)
+"$CARGO_TARGET_DIR/release/gen_images" "$dir" > /dev/null
 tool="$root/../shared/tools/opencv_sift.py"
 [ -f "$tool" ] || { echo "opencv_sift.py not found beside the repository (../shared/tools)" >&2; exit 1; }
 for img in map_1024 texture_1024; do
   ours=(); cv=()
   for _ in $(seq "$rounds"); do
-    ours+=("$("$CARGO_TARGET_DIR/release/examples/sift_json" "$dir/$img.png" "$dir/o.json" --runs "$runs" | sed -E 's/.*median ([0-9.]+) ms.*/\1/')")
+    ours+=("$("$CARGO_TARGET_DIR/release/sift_json" "$dir/$img.png" "$dir/o.json" --runs "$runs" | sed -E 's/.*median ([0-9.]+) ms.*/\1/')")
     cv+=("$(python3 "$tool" "$dir/$img.png" --runs "$runs" | sed -E 's/.*median ([0-9.]+) ms.*/\1/')")
   done
   python3 - "$img" "${ours[*]}" "${cv[*]}" <<'PY'

@@ -8,7 +8,7 @@ here="$(cd "$(dirname "$0")" && pwd)"
 root="$(cd "$here/../../.." && pwd)"
 out="$(mktemp -d)"
 export CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-$root/target}"
-(cd "$root" && cargo run -q -p mrslam-sift --release --example sift_json -- "$img" "$out/ours.json" --runs "$runs")
+(cd "$root" && cargo run -q --release -p mrslam-dev --bin sift_json -- "$img" "$out/ours.json" --runs "$runs")
 tool="$root/../shared/tools/opencv_sift.py"
 [ -f "$tool" ] || { echo "opencv_sift.py not found beside the repository (../shared/tools)" >&2; exit 1; }
 python3 "$tool" "$img" --runs "$runs" --json "$out/opencv.json"

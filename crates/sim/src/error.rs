@@ -31,7 +31,7 @@ pub enum SimError {
         /// World file that names the map.
         path: PathBuf,
         /// Underlying map error.
-        cause: mrslam_core::MapIoError,
+        cause: mrslam_core::map_io::MapIoError,
     },
     /// A robot's start pose places its footprint inside an obstacle or another robot.
     #[error("robot `{name}`: start pose ({x:.3}, {y:.3}) overlaps an obstacle or another robot")]

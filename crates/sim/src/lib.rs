@@ -3,26 +3,29 @@
 //! Build a [`WorldSpec`] (from a TOML world file), a [`Sim`] over it, add robots with
 //! [`Sim::add_robot`], command their wheels, [`Sim::step`], and read [`Sim::odometry`],
 //! [`Sim::take_scan`] and the ground truth ([`Sim::true_pose`], [`World::true_map`]).
-//! Units are SI; poses are [`mrslam_core::Pose2`]; rapier's glam types stay inside [`sim`].
+//! Units are SI; poses are [`mrslam_core::Pose2`]; rapier's glam types stay inside this crate.
+//!
+//! Modules are private; the items re-exported below are the API.
 
-#![warn(missing_docs)]
+#![deny(missing_docs)]
 
-pub mod bitmap;
-pub mod drive;
-pub mod encoder;
-pub mod error;
-pub mod geometry;
-pub mod lidar;
-pub mod raycast;
-pub mod sim;
-pub mod slip;
-pub mod truth;
-pub mod world;
-pub mod world_file;
+mod bitmap;
+mod drive;
+mod encoder;
+mod error;
+mod geometry;
+mod lidar;
+mod raycast;
+mod sim;
+mod slip;
+mod truth;
+mod world;
+mod world_file;
 
 pub use drive::{DiffDrive, Footprint, RobotModel};
 pub use encoder::{EncoderParams, Encoders};
 pub use error::SimError;
+pub use geometry::Obstacle;
 pub use lidar::LidarModel;
 pub use sim::{RayBackend, RobotId, RobotStep, Sim, SimConfig, StepEvents};
 pub use slip::{SlipParams, SlipState};

@@ -103,7 +103,7 @@ pub fn poses_at_every_scan(stamps: &[f64], odometry: &[Pose2], processed: &[(usi
 #[cfg(test)]
 mod tests {
     use super::*;
-    use mrslam_core::pose::{Xyt, pose};
+    use mrslam_core::{Xyt, pose};
 
     #[test]
     fn processed_scans_keep_their_poses_and_the_correction_is_spread_between_them() {

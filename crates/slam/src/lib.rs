@@ -4,32 +4,45 @@
 //! particle filters", as OpenSLAM's GMapping implements it: each particle carries a pose, a log weight, its
 //! own grid map and its trajectory; the proposal is the odometry motion model refined by a scan matcher on
 //! the particle's own map (GMapping's hill climber by default; the presets use a likelihood-field matcher,
-//! [`field`]); weights are the scan likelihood at the matched pose; particles are resampled (systematic)
+//! `field`); weights are the scan likelihood at the matched pose; particles are resampled (systematic)
 //! when the effective sample size drops below a threshold.
 //!
-//! Data flow per [`Rbpf::process`] call: odometry increment → [`motion`] sampling for every particle →
-//! (when the robot moved enough) [`scan_matcher`] refinement and likelihood → [`resample`] → the scan's hits
-//! go into each particle's copy-on-write [`tile_map`] → a new [`particle`] trajectory node.
-//! The output map ([`Rbpf::map`]) is rebuilt by [`map_build`] from the best particle's trajectory.
+//! Data flow per [`Rbpf::process`] call: odometry increment → `motion` sampling for every particle →
+//! (when the robot moved enough) `scan_matcher` refinement and likelihood → `resample` → the scan's hits
+//! go into each particle's copy-on-write `tile_map` → a new `particle` trajectory node.
+//! The output map ([`Rbpf::map`]) is rebuilt by `map_build` from the best particle's trajectory.
+//!
+//! Modules are private: the items below are the API; [`synthetic`] (test data) is a public namespace and
+//! [`dev`] holds internals public only for the development probes (`dev/` in the repository).
 //!
 //! Units are SI; poses are `nalgebra::Isometry2<f64>`; the map frame is the first processed robot pose.
 
+#![deny(missing_docs)]
+
 mod calibration;
-pub mod error;
-pub mod every_scan;
-pub mod field;
-pub mod map_build;
-pub mod motion;
-pub mod params;
-pub mod particle;
-pub mod rbpf;
-pub mod resample;
-pub mod scan_matcher;
-pub mod scan_odometry;
+mod error;
+mod every_scan;
+mod field;
+mod map_build;
+mod motion;
+mod params;
+mod particle;
+mod rbpf;
+mod resample;
+mod scan_matcher;
+mod scan_odometry;
 pub mod synthetic;
-pub mod tile_map;
+mod tile_map;
 
 pub use error::SlamError;
 pub use every_scan::{LogRun, LogRunError, map_log, poses_at_every_scan};
-pub use params::{Preset, SlamParams};
-pub use rbpf::{MemoryStats, Rbpf, SkipReason, UpdateOutcome, UpdateStats};
+pub use params::{MatcherKind, Preset, SlamParams};
+pub use rbpf::{Counters, MemoryStats, Rbpf, SkipReason, UpdateOutcome, UpdateStats};
+
+/// Internals public only for the development probes (`dev/src/bin/matcher_lab.rs`, `matcher_check.rs`): the
+/// scan matcher on a hand-built tile map. Not part of the crate's API; the filter ([`Rbpf`]) is.
+pub mod dev {
+    pub use crate::field::Lookup;
+    pub use crate::scan_matcher::{PreparedScan, ScanMatcher, Scratch};
+    pub use crate::tile_map::TileMap;
+}

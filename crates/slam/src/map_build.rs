@@ -12,8 +12,8 @@
 
 use crate::params::SlamParams;
 use crate::particle::TrajectoryNode;
+use mrslam_core::MAX_CELLS;
 use mrslam_core::Xyt;
-use mrslam_core::grid::MAX_CELLS;
 use mrslam_core::map_io::ROS_LOGODDS_LIMIT;
 use mrslam_core::{CellTraversal, LaserScan, OccupancyGrid, pose};
 

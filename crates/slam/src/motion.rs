@@ -1,6 +1,8 @@
 //! The odometry motion model: GMapping's `MotionModel::drawFromMotion`.
 
-use mrslam_core::pose::{Pose2, Xyt, normalize_angle, pose, relative};
+use mrslam_core::{Pose2, pose, pose::normalize_angle};
+#[cfg(test)]
+use mrslam_core::{Xyt, pose::relative};
 use rand::Rng;
 use rand_distr::StandardNormal;
 
@@ -32,6 +34,7 @@ impl MotionModel {
     /// GMapping's formula: the increment `delta = old⁻¹ ⊕ new` (in the old odometry frame) gets noise
     /// `x += N(srr|dx| + str|dθ| + 0.3·srr|dy|)`, `y += N(srr|dy| + str|dθ| + 0.3·srr|dx|)`,
     /// `θ += N(stt|dθ| + srt·|(dx, dy)|)` (standard deviations), and is composed onto `p`.
+    #[cfg(test)]
     pub fn draw_from_motion<R: Rng>(&self, rng: &mut R, p: &Pose2, new: &Pose2, old: &Pose2) -> Pose2 {
         let Xyt { x: dx, y: dy, theta: dt } = Xyt::from_pose(&relative(old, new));
         self.draw_increment(rng, p, dx, dy, dt)

@@ -84,7 +84,7 @@ pub struct SlamParams {
     pub unknown_score: f64,
     /// Not GMapping: `matcher`, the scan matcher: `gmapping` (the default: GMapping's kernel search per beam
     /// and pose) or `field` (a likelihood field of surface segments built once per particle and update, one
-    /// table read per beam, then Gauss-Newton refinement; see [`crate::field`]).
+    /// table read per beam, then Gauss-Newton refinement; see `field`).
     pub matcher: MatcherKind,
     /// Not GMapping: `field_reach`, cells: how far from a surface the `field` matcher still finds it (a beam
     /// ending farther from every surface is unmatched). GMapping's kernel reaches `kernel_size` + ½ cell.
@@ -125,7 +125,7 @@ pub struct SlamParams {
     /// corridor, whose odometry has no scale error, it did not help, so no preset turns it on.
     pub odometry_calibration: f64,
     /// Not GMapping: `scan_odometry`: match every scan against a local map of the scans before it and move
-    /// the particles by the matched increments instead of the raw odometry's (see [`crate::scan_odometry`]).
+    /// the particles by the matched increments instead of the raw odometry's (see `scan_odometry`).
     /// Off (the default): raw odometry, as GMapping.
     pub scan_odometry: bool,
     /// Not GMapping: `scan_odometry_submap`: scans per submap of the scan odometry's local map (it matches
@@ -143,7 +143,7 @@ pub struct SlamParams {
     /// increments are centimetres, so a short reach suffices, and its field is built for every scan.
     pub scan_odometry_reach: i32,
     /// Not GMapping: `wall_hits`: in the output map a beam's free-space trace stops at the first cell on its
-    /// way that at least this many beams ended in (see [`crate::map_build`]); 0: traces run to the end
+    /// way that at least this many beams ended in (see `map_build`); 0: traces run to the end
     /// point, as GMapping's.
     pub wall_hits: u32,
     /// Not GMapping: `kernel_likelihood`: with the `field` matcher, weigh each particle by GMapping's kernel
@@ -239,7 +239,7 @@ impl SlamParams {
     ///
     /// GMapping's parameters except:
     /// - `scan_odometry` on: every scan is matched against a local map of the scans before it and the
-    ///   particles move by the matched increments (see [`crate::scan_odometry`]); the motion noise is halved
+    ///   particles move by the matched increments (see `scan_odometry`); the motion noise is halved
     ///   (`srr` 0.05, `srt` 0.1, `str` 0.05, `stt` 0.1), as those increments are better than the wheels'.
     /// - The `field` matcher with the motion prior (`motion_prior` 1): a ±0.05 rad heading search, a short
     ///   climb (`iterations` 2) and Gauss-Newton (`refine_iterations` 10) to the optimum of the score

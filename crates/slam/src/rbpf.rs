@@ -9,8 +9,8 @@ use crate::particle::{Particle, TrajectoryNode, ancestry};
 use crate::resample::{normalize, systematic};
 use crate::scan_matcher::{MatchResult, MotionPrior, PreparedScan, ScanMatcher, Scratch};
 use crate::scan_odometry::ScanOdometry;
-use mrslam_core::pose::{Xyt, relative};
 use mrslam_core::{LaserScan, OccupancyGrid, Odometry, Pose2};
+use mrslam_core::{Xyt, pose::relative};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
@@ -549,7 +549,7 @@ impl Rbpf {
         self.particles.iter().map(|p| p.weight_sum).collect()
     }
 
-    /// The best particle's map as a log-odds grid (occupied +2, free −2, unknown 0; see [`crate::map_build`]).
+    /// The best particle's map as a log-odds grid (occupied +2, free −2, unknown 0; see `map_build`).
     ///
     /// Rebuilt from the best particle's trajectory on every call (like GMapping's ROS node does every
     /// `map_update_interval`): cost grows with the scans processed, so call it when a map is needed.

@@ -23,8 +23,8 @@ use crate::motion::MotionModel;
 use crate::params::{MatcherKind, SlamParams};
 use crate::scan_matcher::{MotionPrior, PreparedScan, ScanMatcher, Scratch};
 use crate::tile_map::TileMap;
-use mrslam_core::pose::{Xyt, pose, relative};
 use mrslam_core::{LaserScan, Pose2};
+use mrslam_core::{Xyt, pose, pose::relative};
 
 /// Smallest standard deviations (x, y metres; heading radians) of the prior on an increment: a robot
 /// that did not move by its odometry may still have moved a little.

@@ -3,9 +3,12 @@
 //!
 //! Nothing here knows about the simulator crate: it uses core's grid ray casting only.
 
-use mrslam_core::pose::{Xyt, normalize_angle, relative};
 use mrslam_core::sensor::LidarSpec;
 use mrslam_core::{LaserScan, OccupancyGrid, Odometry, Pose2, pose};
+use mrslam_core::{
+    Xyt,
+    pose::{normalize_angle, relative},
+};
 use nalgebra::Point2;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;

@@ -67,6 +67,7 @@ impl Tile {
 
 /// A grid of hit statistics made of copy-on-write tiles.
 #[derive(Clone)]
+/// Public (through the crate's `dev` module) only for the tests, benches and development probes.
 pub struct TileMap {
     delta: f64,
     inv_delta: f64,
@@ -183,7 +184,7 @@ impl TileMap {
     }
 
     /// Records the end point (x, y) of a beam travelling along unit direction (dx, dy) (map frame): as
-    /// [`TileMap::add_hit`], and the direction is added to the cell's [`Tile::dir`].
+    /// [`TileMap::add_hit`], and the direction is added to the cell's `Tile::dir`.
     pub fn add_beam_hit(&mut self, x: f64, y: f64, dx: f64, dy: f64) -> Result<(), TooLarge> {
         let (ix, iy) = self.cell_of(x, y);
         let (tx, ty) = (ix >> TILE_SHIFT, iy >> TILE_SHIFT);

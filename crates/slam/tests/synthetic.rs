@@ -1,8 +1,8 @@
 //! End-to-end: the filter on synthetic data with a known map, path and drifting odometry.
 #![allow(clippy::unwrap_used, reason = "a development aid / test: a failed unwrap names the problem")]
 
-use mrslam_core::pose::{Xyt, relative};
 use mrslam_core::{CellState, OccupancyGrid, Odometry, Pose2, pose};
+use mrslam_core::{Xyt, pose::relative};
 use mrslam_slam::synthetic::{self, Drift, Lidar, SyntheticRun};
 use mrslam_slam::{Rbpf, SlamParams, UpdateOutcome};
 
@@ -310,7 +310,7 @@ fn gmappings_matcher_stays_reachable() {
         lskip: 3,
         ..SlamParams::default()
     };
-    assert_eq!(params.matcher, mrslam_slam::params::MatcherKind::Gmapping);
+    assert_eq!(params.matcher, mrslam_slam::MatcherKind::Gmapping);
     let f = run_filter(&run, params, 5);
     let traj = f.trajectory();
     let (slam, odom) = (rms_error(&traj, &run.truth), rms_error(&odometry_at(&run, &traj), &run.truth));

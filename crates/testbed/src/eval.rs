@@ -1,7 +1,7 @@
 //! Evaluation against ground truth, which only the evaluator knows.
 
 use mrslam_core::{OccupancyGrid, Pose2};
-use mrslam_merge::verify::agreement;
+use mrslam_merge::agreement;
 
 /// Root-mean-square position error of `estimate` against `truth`, pairwise, metres (0 for no pairs).
 pub fn rmse(estimate: &[Pose2], truth: &[Pose2]) -> f64 {

@@ -10,7 +10,7 @@ use mrslam_merge::{
     Algorithm, CorrelativeMerger, MatchParams, MergeOutcome, MergeParams, Merger, RmapMerger, RmapParams, SiftMerger,
     SiftMergerParams, merge,
 };
-use mrslam_sim::geometry::Obstacle;
+use mrslam_sim::Obstacle;
 use mrslam_sim::{RobotId, Sim, SimConfig, SimError, StepEvents};
 use mrslam_slam::{Rbpf, SlamError};
 use mrslam_viz::{MergeView, RobotInfo, RunRecorder, SlamState};
@@ -174,9 +174,9 @@ fn merge_pair(scenario: &Scenario) -> Result<(String, String), RunError> {
     }
 }
 
-/// Runs a scenario end to end: the robots drive and map until the merge time ([`drive`]), each robot's
-/// SLAM is evaluated against the truth ([`evaluate_robots`]), then the maps are merged by each algorithm and
-/// every merge is scored against the true transform ([`merge_maps`]).
+/// Runs a scenario end to end: the robots drive and map until the merge time (`drive`), each robot's
+/// SLAM is evaluated against the truth (`evaluate_robots`), then the maps are merged by each algorithm and
+/// every merge is scored against the true transform (`merge_maps`).
 pub fn run(scenario: &Scenario, mut opts: RunOptions) -> Result<RunOutput, RunError> {
     let wall = Instant::now();
     let (host, other) = merge_pair(scenario)?;

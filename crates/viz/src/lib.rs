@@ -11,22 +11,26 @@
 //! `merge/<algorithm>/{keypoints/<name>,matches,merged}`, `metrics/{error,neff,slip}/...`, `events`; timelines
 //! `sim_time` (seconds) and `step`. Nothing here runs unless a recording was asked for.
 
-pub mod blueprint;
-pub mod convert;
-pub mod error;
+#![deny(missing_docs)]
+
+// Private modules, their items re-exported below; `inspect`, `pair` and `paths` are public namespaces
+// (`inspect::summarize`, `pair::record_pair`, the entity paths), their items not re-exported.
+mod blueprint;
+mod convert;
+mod error;
 pub mod inspect;
-pub mod maps;
-pub mod metrics;
+mod maps;
+mod metrics;
 pub mod pair;
 pub mod paths;
-pub mod recorder;
-pub mod robot;
-pub mod run;
-pub mod target;
-pub mod world;
+mod recorder;
+mod robot;
+mod run;
+mod target;
+mod world;
 
 pub use error::VizError;
 pub use metrics::Level;
 pub use recorder::{Recorder, RecordingStats};
 pub use run::{MergeView, Rates, RobotInfo, RunRecorder, SlamState};
-pub use target::Target;
+pub use target::{DEFAULT_CONNECT, Target, partial_path};

@@ -4,7 +4,7 @@
 use rerun::EntityPath;
 use rerun::external::re_log_types::EntityPathPart;
 
-/// Roots drawn in the world's frame; each carries the display flip (see [`crate::world`]).
+/// Roots drawn in the world's frame; each carries the display flip (see the private `world` module).
 pub const SPATIAL_ROOTS: [&str; 4] = ["world", "robots", "maps", "merge"];
 
 fn path(parts: &[&str]) -> EntityPath {

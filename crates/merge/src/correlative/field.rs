@@ -89,6 +89,7 @@ impl ScoreField {
     }
 
     /// The score of cell (`x`, `y`); 0 off the grid.
+    #[cfg(test)]
     #[inline]
     pub fn get(&self, x: i32, y: i32) -> i16 {
         if (x as u32) < self.width as u32 && (y as u32) < self.height as u32 {

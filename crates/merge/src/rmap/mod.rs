@@ -52,7 +52,7 @@ pub mod mers;
 pub mod orient;
 pub mod triangle;
 
-pub use mers::{Connections, CoverRule, FreeMatrix, Mer, Rmap};
+pub use mers::{CoverRule, FreeMatrix, Mer, Rmap};
 pub use orient::OrientParams;
 pub use triangle::{TriangleMatch, TriangleParams};
 

@@ -101,7 +101,7 @@ impl ScanMatcher {
 
     /// The scan's information about robot pose `p` on a likelihood field: the Gauss-Newton normal matrix of
     /// [`ScanMatcher::refine`] without the prior (upper triangle 00 01 02 11 12 22, map frame), i.e. the
-    /// curvature of the negated score in the units of [`PosePrior::info`]. Near zero in a direction the scan
+    /// curvature of the negated score in the units of `PosePrior::info`. Near zero in a direction the scan
     /// does not observe.
     pub fn scan_information(&self, f: &Field, p: &Xyt, beams: &[Beam]) -> [f64; 6] {
         self.normal_equations(f, p, beams).0

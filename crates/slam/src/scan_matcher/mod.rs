@@ -43,7 +43,7 @@ pub enum MatcherKind {
     /// behind it; hill climbing.
     #[default]
     Gmapping,
-    /// A likelihood field of surfels built once per particle and update ([`crate::field`]): one table read
+    /// A likelihood field of surfels built once per particle and update (`field`): one table read
     /// per beam; hill climbing on it, then Gauss-Newton refinement (`refine_iterations`).
     Field,
 }
@@ -93,6 +93,7 @@ impl Beam {
 
 /// A scan prepared for matching and mapping.
 #[derive(Debug, Clone, Default)]
+/// Public (through the crate's `dev` module) only for the tests, benches and development probes.
 pub struct PreparedScan {
     /// Beams the matcher uses: valid, within the usable range, every (lskip+1)-th.
     pub matched: Vec<Beam>,
@@ -131,6 +132,7 @@ impl PreparedScan {
 
 /// The scan matcher's settings (see [`crate::SlamParams`] for each).
 #[derive(Debug, Clone, Copy, PartialEq)]
+/// Public (through the crate's `dev` module) only for the tests, benches and development probes.
 pub struct ScanMatcher {
     /// Laser mount pose on the robot.
     pub laser: Xyt,
@@ -163,7 +165,7 @@ pub struct ScanMatcher {
     pub heading_search: f64,
     /// `field` matcher: step of the heading search, radians.
     pub heading_step: f64,
-    /// `field` matcher: weight of the motion-model prior (0: none; see [`MotionPrior`]).
+    /// `field` matcher: weight of the motion-model prior (0: none; see `MotionPrior`).
     pub motion_prior: f64,
     /// The matched pose replaces the starting pose only when its score exceeds this.
     pub minimum_score: f64,
@@ -173,7 +175,7 @@ pub struct ScanMatcher {
     /// `field` matcher: weigh by GMapping's kernel likelihood at the matched pose instead of the field's.
     pub kernel_likelihood: bool,
     /// `field` matcher: report the scan's and the prior's information at the matched pose
-    /// ([`MatchResult::information`]; set for [`crate::SlamParams::odometry_calibration`]).
+    /// (`MatchResult::information`; set for [`crate::SlamParams::odometry_calibration`]).
     pub information: bool,
 }
 
@@ -233,6 +235,7 @@ impl PosePrior {
 
 /// Per-thread working memory of the matcher (the likelihood field), reused between particles.
 #[derive(Debug, Clone, Default)]
+/// Public (through the crate's `dev` module) only for the tests, benches and development probes.
 pub struct Scratch {
     /// The field of the particle being matched.
     pub field: Field,

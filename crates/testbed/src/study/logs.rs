@@ -14,9 +14,9 @@ use super::StudyError;
 use super::algorithms::study_merger_encoded;
 use super::results::TrialRow;
 use crate::eval::transform_error;
-use mrslam_core::pose::{Xyt, normalize_angle, pose};
 use mrslam_core::relations::{Relation, StampedPose, pose_at};
 use mrslam_core::{CellState, OccupancyGrid, Pose2, ScanRecord};
+use mrslam_core::{Xyt, pose, pose::normalize_angle};
 use mrslam_merge::{Algorithm, MapEncoding, MergeParams, merge};
 use mrslam_slam::{LogRunError, Rbpf, SlamParams, map_log};
 use std::collections::BTreeMap;
@@ -601,7 +601,7 @@ pub fn pairs_table(rows: &[PairRow], summary: &[AlgorithmSummary]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use mrslam_core::pose::pose;
+    use mrslam_core::pose;
     use std::path::PathBuf;
 
     #[test]

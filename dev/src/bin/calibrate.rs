@@ -4,7 +4,7 @@
 //! Variants: `walls` and `paper` encodings with OpenCV's doubled image, `walls-1x` without doubling, and
 //! `robust` (walls grown one cell, 6 candidates per feature, 4 hypotheses: the setting for SLAM maps).
 //!
-//! `cargo run --release -p mrslam-merge --example calibrate -- [PAIRS] [VARIANT]`
+//! `cargo run --release -p mrslam-dev --bin calibrate -- [PAIRS] [VARIANT]`
 
 use mrslam_merge::floorplan::{FloorplanParams, generate};
 use mrslam_merge::pairs::{PairSpec, cut_pair};

@@ -1,5 +1,5 @@
 //! Merges two map files under several merger settings and prints each answer:
-//! `cargo run --release -p mrslam-merge --example try_maps -- A.yaml B.yaml`.
+//! `cargo run --release -p mrslam-dev --bin try_maps -- A.yaml B.yaml`.
 
 use mrslam_core::map_io::read_ros_map;
 use mrslam_merge::{MapEncoding, MergeParams, SiftMerger, SiftMergerParams, merge};

@@ -1,7 +1,7 @@
 //! Runs mrslam-sift on an image file (PNG/PGM) and writes the keypoints as JSON in the layout of
 //! `opencv_sift.py --json`: a list of {x, y, size, angle, response, octave, descriptor}.
 //!
-//! usage: cargo run -p mrslam-sift --release --example sift_json -- IMAGE OUT.json [--runs N]
+//! usage: cargo run --release -p mrslam-dev --bin sift_json -- IMAGE OUT.json [--runs N]
 
 use mrslam_sift::{GrayImage, Sift, SiftParams};
 use std::time::Instant;

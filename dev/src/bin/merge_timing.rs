@@ -1,5 +1,5 @@
 //! Times N merges of the benchmark's 600x600 pair (for CPU-time measurement with `/usr/bin/time`):
-//! `cargo run --release -p mrslam-merge --example merge_timing -- [N] [up|noup] [paper|robust]`.
+//! `cargo run --release -p mrslam-dev --bin merge_timing -- [N] [up|noup] [paper|robust]`.
 
 use mrslam_merge::floorplan::{FloorplanParams, generate};
 use mrslam_merge::pairs::{PairSpec, cut_pair};

@@ -1,13 +1,13 @@
 //! Checks SIFT matches between two maps against a known transform: how many keypoints lie in the shared
 //! part, how many matches are true, and where the ratio test loses the true ones.
-//! `cargo run --release -p mrslam-merge --example diagnose -- A.yaml B.yaml X Y THETA [dilation] [ratio] [paper]`
+//! `cargo run --release -p mrslam-dev --bin diagnose -- A.yaml B.yaml X Y THETA [dilation] [ratio] [paper]`
 //! (X Y THETA: the true `T_a_b`, points of b's frame into a's).
 
 use mrslam_core::map_io::read_ros_map;
 use mrslam_core::{CellState, Pose2};
-use mrslam_merge::map_image::MapImage;
-use mrslam_merge::matching::match_features;
-use mrslam_merge::refine::{refine, wall_points};
+use mrslam_merge::MapImage;
+use mrslam_merge::dev::match_features;
+use mrslam_merge::dev::{refine, wall_points};
 use mrslam_merge::{MapEncoding, MatchParams, RefineParams};
 use mrslam_sift::{GrayImage, Sift, SiftParams};
 use nalgebra::{Point2, Vector2};

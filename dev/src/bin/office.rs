@@ -1,5 +1,5 @@
 //! Accuracy and speed harness on the synthetic runs of the crate's tests:
-//! `cargo run --release -p mrslam-slam --example office -- [hokuyo|rplidar|corridor] [name=value ...]`.
+//! `cargo run --release -p mrslam-dev --bin office -- [hokuyo|rplidar|corridor] [name=value ...]`.
 //!
 //! Diagnostics by environment variable: `DRIFT=scale,heading_per_m,sigma_trans,sigma_rot` (odometry model),
 //! `SIMSEED=S` (the Hokuyo data's seed, 11 as in the test), `SIMLIKE` (the simulator's lidar noise and

@@ -1,6 +1,6 @@
 //! Development aid: the filter on a CARMEN log with any parameters (as `mrslam slam --set NAME=VALUE`),
 //! scored against benchmark relations; builds without the CLI's recording dependencies.
-//! `cargo run --release -p mrslam-slam --example carmen -- LOG RELATIONS [seed=S] [preset=NAME]
+//! `cargo run --release -p mrslam-dev --bin carmen -- LOG RELATIONS [seed=S] [preset=NAME]
 //! [odometry=interpolated|line] [latency=S] [map=OUT.yaml] [name=value ...]`. Environment: `ODOMETRY_ONLY=1` also
 //! scores the filter's odometry alone (scan-matched with `scan_odometry`), `WORST=1` / `WORST_ROT=1` print the
 //! worst relations, `DEBUG_RANGE=T0,T1` prints raw and filter odometry per scan stamped in [T0, T1].

@@ -1,7 +1,7 @@
 //! Runs the correlative merger on two map files (optionally against a known `T_a_b`) or on generated pairs,
 //! with parameter overrides, and prints each answer:
-//! `cargo run --release -p mrslam-merge --example correlative_probe -- A.yaml B.yaml [x y theta] [key=value ...]`
-//! `cargo run --release -p mrslam-merge --example correlative_probe -- gen [key=value ...]`.
+//! `cargo run --release -p mrslam-dev --bin correlative_probe -- A.yaml B.yaml [x y theta] [key=value ...]`
+//! `cargo run --release -p mrslam-dev --bin correlative_probe -- gen [key=value ...]`.
 
 use mrslam_core::map_io::read_ros_map;
 use mrslam_core::{OccupancyGrid, Pose2, pose};
@@ -38,7 +38,7 @@ fn set(p: &mut CorrelativeParams, kv: &str) {
 /// Share of b's walls over a's known cells with a wall of a within `k` cells (square), for k = 1..=4.
 fn tolerant_walls(a: &OccupancyGrid, b: &OccupancyGrid, t: &Pose2) -> Vec<f64> {
     use mrslam_core::CellState;
-    let walls = mrslam_merge::refine::wall_points(b);
+    let walls = mrslam_merge::dev::wall_points(b);
     (1..=4i64)
         .map(|k| {
             let (mut n, mut hit) = (0usize, 0usize);
@@ -65,18 +65,18 @@ fn tolerant_walls(a: &OccupancyGrid, b: &OccupancyGrid, t: &Pose2) -> Vec<f64> {
 /// b's walls in 20 m tiles (b's frame): per tile with 200+ walls over a's known cells, the wall agreement at
 /// `t` and after ICP of that tile alone, as (walls, at t, after tile ICP, tile ICP shift m, rotation deg).
 fn tiles(a: &OccupancyGrid, b: &OccupancyGrid, t: &Pose2) {
-    let walls = mrslam_merge::refine::wall_points(b);
+    let walls = mrslam_merge::dev::wall_points(b);
     let mut by_tile: std::collections::BTreeMap<(i64, i64), Vec<nalgebra::Point2<f64>>> = Default::default();
     for p in &walls {
         by_tile.entry(((p.x / 20.0).floor() as i64, (p.y / 20.0).floor() as i64)).or_default().push(*p);
     }
     for (k, pts) in by_tile {
-        let (n, m) = mrslam_merge::verify::wall_hits(a, &pts, t);
+        let (n, m) = mrslam_merge::dev::wall_hits(a, &pts, t);
         if n < 200 {
             continue;
         }
-        let local = mrslam_merge::refine::refine(a, &pts, t, &mrslam_merge::RefineParams::default());
-        let (_, m2) = mrslam_merge::verify::wall_hits(a, &pts, &local);
+        let local = mrslam_merge::dev::refine(a, &pts, t, &mrslam_merge::RefineParams::default());
+        let (_, m2) = mrslam_merge::dev::wall_hits(a, &pts, &local);
         let d = t.inverse() * local;
         println!(
             "  tile {k:?}: {n} walls, agreement {:.2} -> {:.2} after its own ICP (moved {:.2} m, {:.2} deg)",
@@ -170,10 +170,10 @@ fn main() {
     }
     println!("a {}x{} b {}x{}", a.width(), a.height(), b.width(), b.height());
     if let Some(t) = &truth {
-        let walls = mrslam_merge::refine::wall_points(&b);
-        let refined = mrslam_merge::refine::refine(&a, &walls, t, &mrslam_merge::RefineParams::default());
+        let walls = mrslam_merge::dev::wall_points(&b);
+        let refined = mrslam_merge::dev::refine(&a, &walls, t, &mrslam_merge::RefineParams::default());
         for (name, t) in [("truth", *t), ("truth+icp", refined)] {
-            let agr = mrslam_merge::verify::agreement(&a, &b, &t);
+            let agr = mrslam_merge::agreement(&a, &b, &t);
             println!("  wall agreement at 1..4 cells: {:?}", tolerant_walls(&a, &b, &t));
             println!(
                 "{name}: {:?} omega {:.3} walls {:.3} ({} of {}) common {}",

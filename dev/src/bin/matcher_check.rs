@@ -1,11 +1,11 @@
 //! Development aid: scan-matcher accuracy against a map built from true poses.
 #![allow(clippy::unwrap_used, reason = "a development aid / test: a failed unwrap names the problem")]
 
+use mrslam_core::Xyt;
 use mrslam_core::pose;
-use mrslam_core::pose::Xyt;
-use mrslam_slam::scan_matcher::{PreparedScan, ScanMatcher};
+use mrslam_slam::dev::TileMap;
+use mrslam_slam::dev::{PreparedScan, ScanMatcher};
 use mrslam_slam::synthetic::{self, Drift, Lidar};
-use mrslam_slam::tile_map::TileMap;
 
 fn main() {
     let env = |k: &str, d: f64| std::env::var(k).ok().and_then(|v| v.parse().ok()).unwrap_or(d);

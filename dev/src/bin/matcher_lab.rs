@@ -1,15 +1,18 @@
 //! Development aid: scan-matcher accuracy on maps built from the true poses, the way the filter builds them
 //! (every 5th scan, 0.25 m apart, hits plus the seen band), matching the next processed scan from perturbed
 //! starting poses. Isolates the matcher's error (and bias) from the filter's dynamics.
-//! `cargo run --release -p mrslam-slam --example matcher_lab -- [hokuyo|rplidar] [name=value ...]`
+//! `cargo run --release -p mrslam-dev --bin matcher_lab -- [hokuyo|rplidar] [name=value ...]`
 #![allow(clippy::unwrap_used, reason = "a development aid / test: a failed unwrap names the problem")]
 
+use mrslam_core::Xyt;
 use mrslam_core::pose;
-use mrslam_core::pose::Xyt;
 use mrslam_slam::SlamParams;
-use mrslam_slam::scan_matcher::{MatcherKind, PreparedScan, ScanMatcher};
+use mrslam_slam::dev::TileMap;
 use mrslam_slam::synthetic::{self, Drift, Lidar};
-use mrslam_slam::tile_map::TileMap;
+use mrslam_slam::{
+    MatcherKind,
+    dev::{PreparedScan, ScanMatcher},
+};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
@@ -67,7 +70,7 @@ fn main() {
     let (mut sx, mut sy, mut st, mut ax, mut ay, mut at, mut n) = (0.0f64, 0.0, 0.0, 0.0f64, 0.0f64, 0.0f64, 0.0);
     let (mut better_than_truth, mut worse) = (0, 0);
     let mut max_err: f64 = 0.0;
-    let mut scratch = mrslam_slam::scan_matcher::Scratch::default();
+    let mut scratch = mrslam_slam::dev::Scratch::default();
     let t0 = std::time::Instant::now();
     let mut est: Option<Xyt> = None;
     let mut prev_truth: Option<Xyt> = None;
@@ -131,7 +134,7 @@ fn main() {
                         let u = l.x - ox + c * b.x - s * b.y;
                         let w = l.y - oy + s * b.x + c * b.y;
                         match f.lookup(u, w, c * b.c - s * b.s, s * b.c + c * b.s) {
-                            mrslam_slam::field::Lookup::Hit(d2) => {
+                            mrslam_slam::dev::Lookup::Hit(d2) => {
                                 ((-d2 / params.sigma).exp(), format!("hit {:.4}", d2.sqrt()))
                             }
                             other => (0.0, format!("{other:?}")),

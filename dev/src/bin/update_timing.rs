@@ -1,6 +1,6 @@
 //! Development aid: the benchmark's filter update (30 particles, 667-beam Hokuyo scan, 20 m of a synthetic
 //! corridor mapped) timed many times; prints the minimum and median, robust to a busy machine.
-//! `RAYON_NUM_THREADS=1 cargo run --release -p mrslam-slam --example update_timing -- [name=value ...]`
+//! `RAYON_NUM_THREADS=1 cargo run --release -p mrslam-dev --bin update_timing -- [name=value ...]`
 #![allow(clippy::unwrap_used, reason = "a development aid / test: a failed unwrap names the problem")]
 
 use mrslam_core::pose;

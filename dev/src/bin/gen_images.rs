@@ -1,8 +1,8 @@
 //! Writes the synthetic test images (map-like and textured, 1024x1024) as PNGs into a directory.
 //!
-//! usage: cargo run -p mrslam-sift --release --example gen_images -- DIR
+//! usage: cargo run --release -p mrslam-dev --bin gen_images -- DIR
 
-#[path = "../src/synth.rs"]
+#[path = "../../../crates/sift/src/synth.rs"]
 mod synth;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
