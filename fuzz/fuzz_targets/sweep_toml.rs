@@ -5,6 +5,6 @@ use libfuzzer_sys::fuzz_target;
 fuzz_target!(|data: &[u8]| {
     if let Ok(text) = std::str::from_utf8(data) {
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/fuzz_sweep.toml");
-        let _ = mrslam_testbed::study::Sweep::parse(text, &path);
+        let _ = mrslam_studies::Sweep::parse(text, &path);
     }
 });

@@ -11,12 +11,12 @@ use mrslam_core::relations;
 use mrslam_merge::MapEncoding;
 use mrslam_merge::floorplan::FloorplanParams;
 use mrslam_slam::Preset;
-use mrslam_testbed::study::journal::{collect_params, fingerprint};
-use mrslam_testbed::study::logs::{self, PairRow, ScoreParams};
-use mrslam_testbed::study::results::sort_rows;
-use mrslam_testbed::study::{
-    self, Journal, MapSource, OverlapStudy, Progress, Shard, StudyError, StudyParams, Sweep, TrialRow, collect,
-    parse_range, run_overlap_study, run_sweep, summary::table,
+use mrslam_studies::journal::{collect_params, fingerprint};
+use mrslam_studies::logs::{self, PairRow, ScoreParams};
+use mrslam_studies::results::sort_rows;
+use mrslam_studies::{
+    self as study, Journal, MapSource, OverlapStudy, Progress, Shard, StudyError, StudyParams, Sweep, TrialRow,
+    collect, parse_range, run_overlap_study, run_sweep, summary::table,
 };
 use std::collections::{BTreeMap, BTreeSet};
 use std::io::IsTerminal;

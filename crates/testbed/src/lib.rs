@@ -2,7 +2,7 @@
 
 #![deny(missing_docs)]
 
-// Every module is a public namespace (`scenario::Scenario`, `runner::run`, `study::overlap`...); nothing is
+// Every module is a public namespace (`scenario::Scenario`, `runner::run`...); nothing is
 // re-exported at the root, so each item has one path.
 
 pub mod controller;
@@ -10,4 +10,3 @@ pub mod eval;
 pub mod report;
 pub mod runner;
 pub mod scenario;
-pub mod study;

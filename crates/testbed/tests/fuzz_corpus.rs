@@ -1,9 +1,7 @@
-//! The fuzz corpora of the scenario, sweep and results parsers (fuzz/corpus/<target>/), replayed: none may
-//! panic.
+//! The fuzz corpus of the scenario parser (fuzz/corpus/scenario_toml/), replayed: nothing may panic.
 #![allow(clippy::unwrap_used, reason = "test code: a failed unwrap fails the test")]
 
 use mrslam_testbed::scenario::Scenario;
-use mrslam_testbed::study::{Sweep, results::parse_results, summarise};
 use std::path::{Path, PathBuf};
 
 /// Every text file of `fuzz/corpus/<target>`, with its path.
@@ -23,21 +21,5 @@ fn beside_scenarios(name: &str) -> PathBuf {
 fn scenario_toml_corpus() {
     for (_, text) in corpus("scenario_toml") {
         let _ = Scenario::parse(&text, &beside_scenarios("fuzz.toml"));
-    }
-}
-
-#[test]
-fn sweep_toml_corpus() {
-    for (_, text) in corpus("sweep_toml") {
-        let _ = Sweep::parse(&text, &beside_scenarios("fuzz_sweep.toml"));
-    }
-}
-
-#[test]
-fn study_csv_corpus() {
-    for (path, text) in corpus("study_csv") {
-        if let Ok(rows) = parse_results(&text, &path) {
-            let _ = summarise(&rows);
-        }
     }
 }

@@ -1,4 +1,4 @@
-//! Studies: many seeded merge trials across overlaps, summarised with confidence intervals and plotted.
+//! mrslam-studies: many seeded merge trials across overlaps, summarised with confidence intervals and plotted.
 //!
 //! Two kinds of trial produce the same rows ([`results::TrialRow`]):
 //! - **map level** ([`overlap`]): a ground-truth map (generated floor plan, a world's true map, or a real
@@ -16,6 +16,8 @@
 //! ([`wilson`]) into `summary.csv`; [`plot`] draws `plot.png`. [`shard`] splits one study across processes
 //! and [`results::collect`] joins the shards again. Every trial is seeded from (study seed, overlap index,
 //! trial index) alone ([`trial`]), so a shard computes exactly the rows the whole study would.
+
+#![deny(missing_docs)]
 
 pub mod algorithms;
 pub mod journal;
@@ -47,7 +49,7 @@ pub enum StudyError {
         message: String,
     },
     /// A results file is malformed, or shards disagree.
-    #[error("{}: {message}", crate::scenario::at(path, *line))]
+    #[error("{}: {message}", mrslam_testbed::scenario::at(path, *line))]
     Results {
         /// File at fault.
         path: PathBuf,

@@ -13,12 +13,12 @@
 use super::StudyError;
 use super::algorithms::study_merger_encoded;
 use super::results::TrialRow;
-use crate::eval::transform_error;
 use mrslam_core::relations::{Relation, StampedPose, pose_at};
 use mrslam_core::{CellState, OccupancyGrid, Pose2, ScanRecord};
 use mrslam_core::{Xyt, pose, pose::normalize_angle};
 use mrslam_merge::{Algorithm, MapEncoding, MergeParams, merge};
 use mrslam_slam::{LogRunError, Rbpf, SlamParams, map_log};
+use mrslam_testbed::eval::transform_error;
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::ops::Range;

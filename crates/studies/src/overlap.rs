@@ -6,11 +6,11 @@ use super::results::{TrialRow, sort_rows};
 use super::shard::Shard;
 use super::trial::{TrialSpec, mix, trials};
 use super::{Progress, StudyError};
-use crate::eval::transform_error;
 use mrslam_core::OccupancyGrid;
 use mrslam_merge::floorplan::{FloorplanParams, generate};
 use mrslam_merge::pairs::{PairSpec, cut_pair};
 use mrslam_merge::{Algorithm, MergeParams, merge};
+use mrslam_testbed::eval::transform_error;
 use rayon::prelude::*;
 
 /// Where a study's ground-truth maps come from.

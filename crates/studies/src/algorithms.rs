@@ -8,7 +8,7 @@ use mrslam_merge::{
 ///
 /// The correlative merger has no random draws. Only the SIFT merger's draws (its RANSAC) follow `seed`; the
 /// R-map merger's orientation draws keep their default seed ([`RmapParams::default`], 0) in every trial, as the published studies were computed. A
-/// simulated run ([`crate::runner::merger_for`]) seeds both with the scenario's seed.
+/// simulated run ([`mrslam_testbed::runner::merger_for`]) seeds both with the scenario's seed.
 pub fn study_merger(algorithm: Algorithm, seed: u64) -> Box<dyn Merger> {
     study_merger_encoded(algorithm, seed, MapEncoding::default())
 }
