@@ -10,6 +10,20 @@
 //! Modules are private and their items re-exported here, except the public namespaces [`floorplan`],
 //! [`pairs`] and [`resample`]; [`dev`] holds internals public only for tests, benches and the development
 //! probes.
+//!
+//! ```
+//! use mrslam_merge::floorplan::{FloorplanParams, generate};
+//! use mrslam_merge::pairs::{PairSpec, cut_pair};
+//! use mrslam_merge::{MergeParams, SiftMerger, merge};
+//!
+//! // A generated floor plan cut into two maps that share 40 % of their cells, the second moved at random.
+//! let plan = generate(1, &FloorplanParams::default());
+//! let pair = cut_pair(&plan, &PairSpec { overlap: 0.4, ..Default::default() }, 3);
+//! let out = merge(&SiftMerger::default(), &pair.a, &pair.b, &MergeParams::default());
+//! // Accepted by the verification gate, and the estimate is the true transform within a few centimetres.
+//! let estimate = out.report.transform.unwrap().to_pose();
+//! assert!(out.report.accepted && (estimate.inverse() * pair.t_a_b).translation.vector.norm() < 0.1);
+//! ```
 
 #![deny(missing_docs)]
 

@@ -6,6 +6,28 @@
 //! Units are SI; poses are [`mrslam_core::Pose2`]; rapier's glam types stay inside this crate.
 //!
 //! Modules are private; the items re-exported below are the API.
+//!
+//! ```
+//! use mrslam_sim::{EncoderParams, LidarModel, RobotModel, Sim, SlipParams, WorldSpec};
+//!
+//! let world = WorldSpec::from_toml_file("../../worlds/corridor.toml").unwrap();
+//! let mut sim = Sim::new(&world, 0).unwrap();
+//! let start = mrslam_core::pose(2.0, 2.5, 0.0);
+//! let robot = sim
+//!     .add_robot("experia", RobotModel::experia(), LidarModel::hokuyo_urg_04lx(), SlipParams::default(),
+//!                EncoderParams::default(), start)
+//!     .unwrap();
+//! sim.set_velocity_command(robot, 0.3, 0.0).unwrap();
+//! let mut scans = 0;
+//! while sim.time() < 1.0 {
+//!     sim.step();
+//!     while sim.take_scan(robot).unwrap().is_some() {
+//!         scans += 1;
+//!     }
+//! }
+//! // The truth moved east; the lidar scanned at its 10 Hz.
+//! assert!(sim.true_pose(robot).unwrap().translation.x > 2.1 && scans >= 9);
+//! ```
 
 #![deny(missing_docs)]
 

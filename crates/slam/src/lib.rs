@@ -16,6 +16,23 @@
 //! [`dev`] holds internals public only for the development probes (`dev/` in the repository).
 //!
 //! Units are SI; poses are `nalgebra::Isometry2<f64>`; the map frame is the first processed robot pose.
+//!
+//! ```
+//! use mrslam_slam::synthetic::{self, Drift, Lidar};
+//! use mrslam_slam::{Rbpf, SlamParams};
+//!
+//! // A Hokuyo-class robot driving the first stretch of a synthetic office with drifting odometry.
+//! let path = synthetic::waypoint_path(&synthetic::office_loop(), 0.05, 0.05);
+//! let drift = Drift { scale: 0.02, heading_per_m: 0.01, sigma_trans: 0.01, sigma_rot: 0.01 };
+//! let laser = mrslam_core::pose(0.1, 0.0, 0.0);
+//! let run = synthetic::simulate(&synthetic::office_map(), &path[..60], 0.1, &Lidar::hokuyo(), laser, &drift, 1);
+//! let mut slam = Rbpf::new(SlamParams::hokuyo(), run.laser_offset, 7).unwrap();
+//! for (odom, scan) in run.odometry.iter().zip(&run.scans) {
+//!     slam.process(odom, scan).unwrap();
+//! }
+//! let map = slam.map().unwrap(); // the best particle's occupancy grid
+//! assert!(slam.counters().processed >= 2 && map.width() > 0);
+//! ```
 
 #![deny(missing_docs)]
 

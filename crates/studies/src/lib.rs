@@ -16,6 +16,15 @@
 //! ([`wilson`]) into `summary.csv`; [`plot`] draws `plot.png`. [`shard`] splits one study across processes
 //! and [`results::collect`] joins the shards again. Every trial is seeded from (study seed, overlap index,
 //! trial index) alone ([`trial`]), so a shard computes exactly the rows the whole study would.
+//!
+//! ```
+//! use mrslam_studies::{parse_range, wilson_interval, wilson::Z95};
+//!
+//! // The overlaps of a study (`--overlaps 0.1:0.5:0.1`) and the 95 % interval of 8 successes in 10 trials.
+//! assert_eq!(parse_range("0.1:0.5:0.1").unwrap().len(), 5);
+//! let (lo, hi) = wilson_interval(8, 10, Z95);
+//! assert!(lo > 0.49 && hi < 0.95);
+//! ```
 
 #![deny(missing_docs)]
 

@@ -1,4 +1,13 @@
 //! mrslam-testbed: scenario files, the simulation loop, evaluation against ground truth, and reports.
+//!
+//! ```
+//! use mrslam_testbed::scenario::Scenario;
+//!
+//! // The paper's first experiment: two robots in a 50 m corridor. `runner::run(&scenario, options)` runs it
+//! // end to end (minutes); `runner::write_outputs` writes its maps and report.
+//! let scenario = Scenario::from_file(std::path::Path::new("../../scenarios/paper_corridor.toml")).unwrap();
+//! assert_eq!(scenario.robots.len(), 2);
+//! ```
 
 #![deny(missing_docs)]
 

@@ -10,6 +10,17 @@
 //! `robots/<name>/{truth,truth/path,odom,odom/path,slam/pose,slam/path,slam/particles,scan}`, `maps/<name>`,
 //! `merge/<algorithm>/{keypoints/<name>,matches,merged}`, `metrics/{error,neff,slip}/...`, `events`; timelines
 //! `sim_time` (seconds) and `step`. Nothing here runs unless a recording was asked for.
+//!
+//! ```
+//! use mrslam_viz::{Recorder, Target};
+//!
+//! // A recording written to a file: under a temporary name until it is finished.
+//! let path = std::env::temp_dir().join(format!("mrslam-viz-doc-{}.rrd", std::process::id()));
+//! let recorder = Recorder::open(&[Target::File(path.clone())], "doc", "doc").unwrap();
+//! recorder.finish().unwrap();
+//! assert!(path.exists());
+//! std::fs::remove_file(&path).unwrap();
+//! ```
 
 #![deny(missing_docs)]
 
