@@ -11,13 +11,12 @@ use mrslam_core::relations;
 use mrslam_merge::MapEncoding;
 use mrslam_merge::floorplan::FloorplanParams;
 use mrslam_slam::Preset;
-use mrslam_studies::journal::{collect_params, fingerprint};
+use mrslam_studies::journal::{Journal, StudyParams, collect_params, fingerprint};
 use mrslam_studies::logs::{self, PairRow, ScoreParams};
-use mrslam_studies::results::sort_rows;
-use mrslam_studies::{
-    self as study, Journal, MapSource, OverlapStudy, Progress, Shard, StudyError, StudyParams, Sweep, TrialRow,
-    collect, parse_range, run_overlap_study, run_sweep, summary::table,
-};
+use mrslam_studies::overlap::{MapSource, OverlapStudy, run_overlap_study};
+use mrslam_studies::results::{TrialRow, collect, sort_rows};
+use mrslam_studies::summary::{summarise, table};
+use mrslam_studies::{self as study, Progress, Shard, StudyError, Sweep, parse_range, run_sweep};
 use std::collections::{BTreeMap, BTreeSet};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -617,7 +616,7 @@ fn logs(a: LogsArgs) -> Result<ExitCode> {
     logs::write_pair_rows(&rows, &a.out.join("results.csv"))?;
     logs::write_algorithm_summary(&summary, &a.out.join("summary.csv"))?;
     let trial_rows: Vec<TrialRow> = rows.iter().enumerate().map(|(k, r)| r.to_trial_row(k)).collect();
-    study::plot::draw(&study::summarise(&trial_rows), &a.out.join("plot.png"))?;
+    study::plot::draw(&summarise(&trial_rows), &a.out.join("plot.png"))?;
     print!("{}", logs::pairs_table(&rows, &summary));
     println!(
         "{} parts, {} connected pairs, {} merges in {:.1} s",

@@ -4,7 +4,7 @@
 //! - **map level** ([`overlap`]): a ground-truth map (generated floor plan, a world's true map, or a real
 //!   map) is cut into a pair with a chosen overlap ([`mrslam_merge::pairs::cut_pair`]); every algorithm
 //!   merges the pair through the verification gate and is scored against the pair's true transform;
-//! - **simulation level** ([`sweep`]): a sweep file varies a scenario (seeds, how far each robot's route
+//! - **simulation level** (`sweep`): a sweep file varies a scenario (seeds, how far each robot's route
 //!   reaches); each variant runs the whole simulation, SLAM and merge, and its overlap is the one the
 //!   robots actually observed.
 //!
@@ -13,12 +13,12 @@
 //! relations; it writes its own `results.csv` columns (one row per pair and algorithm).
 //!
 //! Rows go to `results.csv` ([`results`]); [`summary`] bins them by overlap with Wilson intervals
-//! ([`wilson`]) into `summary.csv`; [`plot`] draws `plot.png`. [`shard`] splits one study across processes
+//! (`wilson`) into `summary.csv`; [`plot`] draws `plot.png`. `shard` splits one study across processes
 //! and [`results::collect`] joins the shards again. Every trial is seeded from (study seed, overlap index,
-//! trial index) alone ([`trial`]), so a shard computes exactly the rows the whole study would.
+//! trial index) alone (`trial`), so a shard computes exactly the rows the whole study would.
 //!
 //! ```
-//! use mrslam_studies::{parse_range, wilson_interval, wilson::Z95};
+//! use mrslam_studies::{Z95, parse_range, wilson_interval};
 //!
 //! // The overlaps of a study (`--overlaps 0.1:0.5:0.1`) and the 95 % interval of 8 successes in 10 trials.
 //! assert_eq!(parse_range("0.1:0.5:0.1").unwrap().len(), 5);
@@ -28,18 +28,20 @@
 
 #![deny(missing_docs)]
 
-pub mod algorithms;
+// `journal`, `logs`, `overlap`, `plot`, `results` and `summary` are public namespaces (their items are not
+// re-exported); the other modules are private, their items re-exported below: each item has one path.
+mod algorithms;
 pub mod journal;
 pub mod logs;
 pub mod overlap;
 pub mod plot;
-pub mod range;
+mod range;
 pub mod results;
-pub mod shard;
+mod shard;
 pub mod summary;
-pub mod sweep;
-pub mod trial;
-pub mod wilson;
+mod sweep;
+mod trial;
+mod wilson;
 
 use std::path::PathBuf;
 
@@ -100,14 +102,13 @@ pub trait Progress: Sync {
 impl Progress for () {}
 
 pub use algorithms::{check_algorithms, parse_algorithms, study_merger, study_merger_encoded};
-pub use journal::{Journal, StudyParams};
-pub use overlap::{MapSource, OverlapStudy, run_overlap_study};
 pub use range::parse_range;
-pub use results::{TrialRow, collect, read_results, write_results};
 pub use shard::Shard;
-pub use summary::{SummaryRow, summarise, write_summary};
 pub use sweep::{Sweep, run_sweep};
-pub use wilson::wilson_interval;
+pub use wilson::{Z95, wilson_interval};
+
+use results::{TrialRow, write_results};
+use summary::{SummaryRow, summarise, write_summary};
 
 /// Writes `results.csv`, `summary.csv` and `plot.png` of `rows` into `dir` (created if needed).
 pub fn write_outputs(rows: &[TrialRow], dir: &std::path::Path) -> Result<Vec<SummaryRow>, StudyError> {

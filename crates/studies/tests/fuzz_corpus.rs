@@ -1,7 +1,9 @@
 //! The fuzz corpora of the sweep and results parsers (fuzz/corpus/<target>/), replayed: nothing may panic.
 #![allow(clippy::unwrap_used, reason = "test code: a failed unwrap fails the test")]
 
-use mrslam_studies::{Sweep, results::parse_results, summarise};
+use mrslam_studies::Sweep;
+use mrslam_studies::results::parse_results;
+use mrslam_studies::summary::summarise;
 use std::path::{Path, PathBuf};
 
 /// Every text file of `fuzz/corpus/<target>`, with its path.
