@@ -1,9 +1,11 @@
-//! The fuzz corpora of the sweep and results parsers (fuzz/corpus/<target>/), replayed: nothing may panic.
+//! The fuzz corpora of the scenario, sweep and results parsers (fuzz/corpus/<target>/), replayed: nothing may
+//! panic. (The scenario parser is testbed's; it is replayed here, beside the sweeps built on it.)
 #![allow(clippy::unwrap_used, reason = "test code: a failed unwrap fails the test")]
 
 use mrslam_studies::Sweep;
 use mrslam_studies::results::parse_results;
 use mrslam_studies::summary::summarise;
+use mrslam_testbed::scenario::Scenario;
 use std::path::{Path, PathBuf};
 
 /// Every text file of `fuzz/corpus/<target>`, with its path.
@@ -17,6 +19,13 @@ fn corpus(target: &str) -> Vec<(PathBuf, String)> {
 /// Where the fuzz targets anchor relative paths: beside the shipped scenarios.
 fn beside_scenarios(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenarios").join(name)
+}
+
+#[test]
+fn scenario_toml_corpus() {
+    for (_, text) in corpus("scenario_toml") {
+        let _ = Scenario::parse(&text, &beside_scenarios("fuzz.toml"));
+    }
 }
 
 #[test]
