@@ -10,9 +10,8 @@
 //! the robot had at that instant, so a moving robot's scan is distorted as on a real robot.
 
 use crate::error::{SimError, bad_param, check_non_negative, check_positive};
-use mrslam_core::Pose2;
-use mrslam_core::Xyt;
 use mrslam_core::sensor::{self, LidarSpec};
+use mrslam_core::{Pose2, Xyt};
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};

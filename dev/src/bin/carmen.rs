@@ -56,10 +56,13 @@ fn main() {
     }
     let secs = t.elapsed().as_secs_f64();
     let stamps: Vec<f64> = log.scans.iter().map(|r| r.scan.stamp).collect();
-    let anchors: Vec<(usize, Pose2)> = processed.iter().copied().zip(f.trajectory().into_iter().map(|k| k.1)).collect();
-    let poses = poses_at_every_scan(&stamps, &odometry, &anchors).expect("processed scans");
-    let traj: Vec<StampedPose> = stamps.iter().zip(poses).map(|(&stamp, pose)| StampedPose { stamp, pose }).collect();
-    let s = relations::score(&traj, &rels, 0.001);
+    // A pose at every scan from a particle's path (one pose per processed scan).
+    let at_every_scan = |path: Vec<(f64, Pose2)>| -> Vec<StampedPose> {
+        let anchors: Vec<(usize, Pose2)> = processed.iter().copied().zip(path.into_iter().map(|k| k.1)).collect();
+        let poses = poses_at_every_scan(&stamps, &odometry, &anchors).expect("processed scans");
+        stamps.iter().zip(poses).map(|(&stamp, pose)| StampedPose { stamp, pose }).collect()
+    };
+    let s = relations::score(&at_every_scan(f.trajectory()), &rels, 0.001);
     let c = f.counters();
     if std::env::var("ODOMETRY_ONLY").is_ok() {
         let traj: Vec<StampedPose> =
@@ -71,15 +74,8 @@ fn main() {
     }
     if std::env::var("ALL_PARTICLES").is_ok() {
         // every final particle's trajectory scored: is the chosen one the best, or are they all alike?
-        let mut all: Vec<(f64, usize, f64)> = (0..f.particles().count())
-            .map(|i| {
-                let anchors: Vec<(usize, Pose2)> =
-                    processed.iter().copied().zip(f.particle_trajectory(i).into_iter().map(|k| k.1)).collect();
-                let poses = poses_at_every_scan(&stamps, &odometry, &anchors).expect("processed scans");
-                let traj: Vec<StampedPose> =
-                    stamps.iter().zip(poses).map(|(&stamp, pose)| StampedPose { stamp, pose }).collect();
-                (relations::score(&traj, &rels, 0.001).translation.mean, i, f.lineage_log_likelihoods()[i])
-            })
+        let mut all: Vec<(f64, usize)> = (0..f.particles().count())
+            .map(|i| (relations::score(&at_every_scan(f.particle_trajectory(i)), &rels, 0.001).translation.mean, i))
             .collect();
         all.sort_by(|a, b| a.0.total_cmp(&b.0));
         let best = f.best_index();
