@@ -162,7 +162,7 @@ pub fn run(args: SlamArgs) -> Result<ExitCode> {
     map_io::write_ros_map(&map, &args.output).with_context(|| format!("{}", args.output.display()))?;
 
     // A pose for every scan: the filter's at the processed ones, odometry in between.
-    let (poses, processed) = (run.poses, run.processed);
+    let (poses, processed, loops) = (run.poses, run.processed, run.loop_closure);
     let stamps: Vec<f64> = log.scans.iter().map(|r| r.scan.stamp).collect();
     let trajectory: Vec<StampedPose> =
         stamps.iter().zip(&poses).map(|(&stamp, &pose)| StampedPose { stamp, pose }).collect();
@@ -171,11 +171,16 @@ pub fn run(args: SlamArgs) -> Result<ExitCode> {
             "mrslam slam {}: one pose per scan ({} scans), `stamp x y theta`, the best particle's robot pose in \
              the map frame.\n{} scans were processed by the filter and carry its pose; every other scan is placed \
              by the {} from the processed scan before it and back from the processed scan after it, blended \
-             by time (before the first / after the last processed scan: odometry from it).",
+             by time (before the first / after the last processed scan: odometry from it).{}",
             args.log.display(),
             trajectory.len(),
             processed.len(),
-            if filter.params().scan_odometry { "scan-matched odometry" } else { "odometry" }
+            if filter.params().scan_odometry { "scan-matched odometry" } else { "odometry" },
+            if loops.is_some_and(|l| l.closures > 0) {
+                "\nThe processed scans' poses are the loop-closed (smoothed) ones."
+            } else {
+                ""
+            }
         );
         write_file_atomic(path, relations::format_trajectory(&header, &trajectory).as_bytes())?;
     }
@@ -220,6 +225,13 @@ pub fn run(args: SlamArgs) -> Result<ExitCode> {
     if filter.params().scan_odometry {
         let (matched, dead) = filter.scan_odometry_counts();
         println!("scan odometry: {matched} scans matched, {dead} kept the raw odometry's increment");
+    }
+    if let Some(l) = &loops {
+        println!(
+            "loop closure: {} of {} processed scans matched a place passed a loop ago; {} loop edges; the \
+             smoothing moved a scan by at most {:.2} m ({} iterations)",
+            l.candidates, c.processed, l.closures, l.max_correction, l.iterations
+        );
     }
     if filter.params().odometry_calibration > 0.0 {
         let [scale, heading] = filter.odometry_calibration();
@@ -269,6 +281,12 @@ pub fn run(args: SlamArgs) -> Result<ExitCode> {
                 let (matched, dead) = filter.scan_odometry_counts();
                 json!({ "matched": matched, "raw": dead })
             }),
+            "loop_closure": loops.map(|l| json!({
+                "candidates": l.candidates,
+                "closures": l.closures,
+                "max_correction_m": l.max_correction,
+                "iterations": l.iterations,
+            })),
             "metric": score.as_ref().map(|s| super::eval::to_json(s, args.tolerance, 10)),
         });
         super::eval::write_json(path, &summary)?;

@@ -8,7 +8,7 @@
 //! Scans before the first processed scan are placed by odometry back from it, scans after the last by
 //! odometry from it.
 
-use crate::{Rbpf, SlamError, UpdateOutcome};
+use crate::{LoopClosureReport, Rbpf, SlamError, UpdateOutcome};
 use mrslam_core::pose::interpolate;
 use mrslam_core::{LaserScan, Odometry, Pose2};
 
@@ -19,6 +19,8 @@ pub struct LogRun {
     pub poses: Vec<Pose2>,
     /// Indices of the scans the filter processed.
     pub processed: Vec<usize>,
+    /// What loop closure did (`None` when [`crate::SlamParams::loop_closure`] is off).
+    pub loop_closure: Option<LoopClosureReport>,
 }
 
 /// Why [`map_log`] stopped.
@@ -39,7 +41,8 @@ pub enum LogRunError {
 
 /// Feeds `filter` a log's readings (each scan with its odometry, in order) and places every scan: the filter's
 /// pose at the processed ones, its odometry (scan-matched when `scan_odometry` is on) in between.
-/// `on_reading` sees each reading's outcome (for progress); the map is the filter's afterwards.
+/// `on_reading` sees each reading's outcome (for progress); with `loop_closure` on, the trajectory is then
+/// smoothed ([`Rbpf::close_loops`]). The map is the filter's afterwards.
 pub fn map_log<'a>(
     filter: &mut Rbpf,
     readings: impl IntoIterator<Item = (&'a Odometry, &'a LaserScan)>,
@@ -57,11 +60,12 @@ pub fn map_log<'a>(
         }
         on_reading(&out);
     }
+    let loop_closure = filter.params().loop_closure.then(|| filter.close_loops());
     let keyframes = filter.trajectory();
     debug_assert_eq!(keyframes.len(), processed.len(), "one trajectory node per processed scan");
     let anchors: Vec<(usize, Pose2)> = processed.iter().copied().zip(keyframes.into_iter().map(|(_, p)| p)).collect();
     let poses = poses_at_every_scan(&stamps, &odometry, &anchors).ok_or(LogRunError::NothingProcessed)?;
-    Ok(LogRun { poses, processed })
+    Ok(LogRun { poses, processed, loop_closure })
 }
 
 /// Poses for every scan, given each scan's stamp and odometry and the filter's poses at the processed

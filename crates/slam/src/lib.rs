@@ -10,7 +10,9 @@
 //! Data flow per [`Rbpf::process`] call: odometry increment → `motion` sampling for every particle →
 //! (when the robot moved enough) `scan_matcher` refinement and likelihood → `resample` → the scan's hits
 //! go into each particle's copy-on-write `tile_map` → a new `particle` trajectory node.
-//! The output map ([`Rbpf::map`]) is rebuilt by `map_build` from the best particle's trajectory.
+//! The output map ([`Rbpf::map`]) is rebuilt by `map_build` from the best particle's trajectory; with
+//! `loop_closure` on, [`map_log`] first smooths that trajectory ([`Rbpf::close_loops`]: `loop_closure` finds
+//! loop edges, `pose_graph` optimises).
 //!
 //! Modules are private: the items below are the API; [`synthetic`] (test data) is a public namespace and
 //! [`dev`] holds internals public only for the development probes (`dev/` in the repository).
@@ -40,10 +42,12 @@ mod calibration;
 mod error;
 mod every_scan;
 mod field;
+mod loop_closure;
 mod map_build;
 mod motion;
 mod params;
 mod particle;
+mod pose_graph;
 mod rbpf;
 mod resample;
 mod scan_matcher;
@@ -53,6 +57,7 @@ mod tile_map;
 
 pub use error::SlamError;
 pub use every_scan::{LogRun, LogRunError, map_log, poses_at_every_scan};
+pub use loop_closure::LoopClosureReport;
 pub use params::{MatcherKind, Preset, SlamParams};
 pub use rbpf::{Counters, MemoryStats, Rbpf, SkipReason, UpdateOutcome, UpdateStats};
 

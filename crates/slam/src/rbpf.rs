@@ -2,6 +2,7 @@
 
 use crate::calibration::{CalibrationMatch, OdometryCalibration};
 use crate::error::SlamError;
+use crate::loop_closure::LoopClosureReport;
 use crate::map_build::build_map;
 use crate::motion::MotionModel;
 use crate::params::SlamParams;
@@ -541,6 +542,36 @@ impl Rbpf {
         let mut v: Vec<(f64, Pose2)> = ancestry(&p.node).map(|n| (n.stamp, n.pose.to_pose())).collect();
         v.reverse();
         v
+    }
+
+    /// Smooths the best particle's trajectory by loop closure (see [`SlamParams::loop_closure`]; runs whether
+    /// or not that is set) and returns what it did: the trajectory, [`Rbpf::map`] and [`Rbpf::best_pose`] are
+    /// the smoothed ones afterwards.
+    ///
+    /// Meant for the end of a log: the particles' matching maps are not rebuilt, so a filter that goes on
+    /// after it matches against maps that do not fit the smoothed trajectory.
+    pub fn close_loops(&mut self) -> LoopClosureReport {
+        let best = self.best_index();
+        let part = &self.particles[best];
+        let mut nodes: Vec<&TrajectoryNode> = ancestry(&part.node).collect();
+        nodes.reverse();
+        let (poses, report) = crate::loop_closure::close_loops(&nodes, self.laser, &self.params);
+        if report.closures == 0 {
+            return report;
+        }
+        let last_old = nodes.last().map(|n| n.pose);
+        let mut chain: Option<Arc<TrajectoryNode>> = None;
+        for (n, p) in nodes.iter().zip(&poses) {
+            chain = Some(Arc::new(TrajectoryNode { stamp: n.stamp, pose: *p, scan: n.scan.clone(), parent: chain }));
+        }
+        let moved = match (last_old, poses.last()) {
+            (Some(old), Some(new)) => Xyt::from_pose(&(new.to_pose() * relative(&old.to_pose(), &part.pose.to_pose()))),
+            _ => part.pose,
+        };
+        let part = &mut self.particles[best];
+        part.node = chain;
+        part.pose = moved;
+        report
     }
 
     /// Each particle's accumulated log-likelihood over its lineage (GMapping's `weightSum`; the best

@@ -371,7 +371,10 @@ fn matched_preset_closes_the_loop_on_every_seed() {
     let (so_rms, so_end) = (rms_error(&matched, &run.truth), end(&matched));
     assert!(so_rms <= 0.1 && so_end <= 0.1, "scan odometry alone: RMS {so_rms} m, end {so_end} m");
     for seed in 0..5 {
-        let f = run_filter(&run, SlamParams::matched(), seed);
+        let mut f = run_filter(&run, SlamParams::matched(), seed);
+        // the preset's loop closure (as `map_log` runs it at the end of a log): it finds the lap's loop
+        let report = f.close_loops();
+        assert!(report.closures >= 1, "seed {seed}: {report:?}");
         let traj = f.trajectory();
         let rms = rms_error(&traj, &run.truth);
         // the filter's last pose is the best particle's, moved by odometry since its last update
@@ -379,7 +382,9 @@ fn matched_preset_closes_the_loop_on_every_seed() {
         let mut closed = traj.clone();
         closed.push(last);
         let e = end(&closed);
-        // measured: RMS 0.029-0.064 m, loop closure 0.005-0.035 m (odometry: 6.9 m RMS, 4.4 m at the end)
-        assert!(rms <= 0.07 && e <= 0.04, "seed {seed}: RMS {rms} m, loop closure error {e} m");
+        eprintln!("seed {seed}: RMS {rms} m, end {e} m, {report:?}");
+        // measured: RMS 0.027-0.033 m, loop closure 0.010-0.041 m (odometry: 6.9 m RMS, 4.4 m at the end);
+        // without the loop closure RMS 0.029-0.064 m, 0.005-0.035 m
+        assert!(rms <= 0.045 && e <= 0.05, "seed {seed}: RMS {rms} m, loop closure error {e} m");
     }
 }

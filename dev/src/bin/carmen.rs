@@ -3,7 +3,8 @@
 //! `cargo run --release -p mrslam-dev --bin carmen -- LOG RELATIONS [seed=S] [preset=NAME]
 //! [odometry=interpolated|line] [latency=S] [map=OUT.yaml] [name=value ...]`. Environment: `ODOMETRY_ONLY=1` also
 //! scores the filter's odometry alone (scan-matched with `scan_odometry`), `WORST=1` / `WORST_ROT=1` print the
-//! worst relations, `DEBUG_RANGE=T0,T1` prints raw and filter odometry per scan stamped in [T0, T1].
+//! worst relations, `DETAIL=1` the long relations off by more than 0.12 m with their error in the first pose's frame,
+//! `DEBUG_RANGE=T0,T1` prints raw and filter odometry per scan stamped in [T0, T1].
 
 use mrslam_core::Xyt;
 use mrslam_core::relations::{self, StampedPose};
@@ -53,6 +54,11 @@ fn main() {
                 );
             }
         }
+    }
+    if f.params().loop_closure {
+        let t = std::time::Instant::now();
+        let r = f.close_loops();
+        println!("loop closure: {r:?} in {:.2} s", t.elapsed().as_secs_f64());
     }
     let secs = t.elapsed().as_secs_f64();
     let stamps: Vec<f64> = log.scans.iter().map(|r| r.scan.stamp).collect();
@@ -107,6 +113,31 @@ fn main() {
     if std::env::var("LONG").is_ok() {
         for e in s.errors.iter().filter(|e| (e.t2 - e.t1).abs() > 10.0) {
             println!("  long {:.1}-{:.1} s: {:.3} m {:.2} deg", e.t1, e.t2, e.translation, e.rotation.to_degrees());
+        }
+    }
+    if std::env::var("DETAIL").is_ok() {
+        // the worst long relations' errors in the first pose's frame, and the nearest processed scans
+        let traj = at_every_scan(f.trajectory());
+        let at =
+            |t: f64| traj.iter().min_by(|a, b| (a.stamp - t).abs().total_cmp(&(b.stamp - t).abs())).expect("poses");
+        for r in &rels {
+            let (a, b) = (at(r.t1), at(r.t2));
+            let est = Xyt::from_pose(&a.pose.inv_mul(&b.pose));
+            let tru = Xyt::from_pose(&r.delta);
+            let (ex, ey) = (est.x - tru.x, est.y - tru.y);
+            if ex.hypot(ey) > 0.12 && (r.t2 - r.t1).abs() > 10.0 {
+                println!(
+                    "  rel {:.1}-{:.1}: true ({:.2}, {:.2}, {:.1} deg) error ({:+.3}, {:+.3}, {:+.2} deg)",
+                    r.t1,
+                    r.t2,
+                    tru.x,
+                    tru.y,
+                    tru.theta.to_degrees(),
+                    ex,
+                    ey,
+                    (est.theta - tru.theta).to_degrees()
+                );
+            }
         }
     }
     if std::env::var("WORST").is_ok() {
