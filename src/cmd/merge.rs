@@ -54,6 +54,10 @@ pub struct MergeArgs {
     /// Grow occupied cells by this many cells before SIFT (0 = the map as it is).
     #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u32).range(0..=4))]
     pub wall_dilation: u32,
+    /// The verification gate's wall tolerance: a wall of map b meets a wall of map a within this many cells
+    /// (1: the 3x3 neighbourhood, the default; maps of two robots' SLAM runs may need 2).
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(0..=4))]
+    pub wall_tolerance: u32,
     /// Map-to-image encoding: `walls` (free and unknown alike) or `paper` (unknown grey).
     #[arg(long, default_value = "walls", value_parser = ["walls", "paper"])]
     pub encoding: String,
@@ -135,7 +139,8 @@ pub fn run(args: MergeArgs) -> Result<ExitCode> {
         }
         Algorithm::Correlative => Box::new(CorrelativeMerger::default()),
     };
-    let mp = MergeParams { verify_enabled: !args.no_verify, fusion: args.fusion, ..MergeParams::default() };
+    let mut mp = MergeParams { verify_enabled: !args.no_verify, fusion: args.fusion, ..MergeParams::default() };
+    mp.verify.wall_tolerance_cells = args.wall_tolerance as usize;
     if !args.more.is_empty() {
         return super::merge_many::run(&args, vec![a, b], merger.as_ref(), &mp);
     }

@@ -148,13 +148,17 @@ pub struct LogsArgs {
     /// Set any SLAM parameter by its name (repeatable; after the preset), as `mrslam slam --set`.
     #[arg(long = "slam-set", value_name = "NAME=VALUE")]
     pub slam_set: Vec<String>,
-    /// Algorithms, comma-separated (sift, rmap).
+    /// Algorithms, comma-separated (sift, rmap, correlative).
     #[arg(long, default_value = "sift,rmap", value_delimiter = ',')]
     pub algorithms: Vec<String>,
     /// The SIFT merger's map-to-image encoding: `walls` (free and unknown alike, the default) or `paper`
     /// (unknown grey, the paper's).
     #[arg(long, default_value = "walls", value_parser = ["walls", "paper"])]
     pub encoding: String,
+    /// The verification gate's wall tolerance: a wall of map b meets a wall of map a within this many cells
+    /// (1: the 3x3 neighbourhood, the default; maps of two robots' SLAM runs may need 2).
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(0..=4))]
+    pub wall_tolerance: u32,
     /// Seed of the SLAM filter (every part) and of the mergers' draws.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
@@ -481,6 +485,7 @@ fn logs(a: LogsArgs) -> Result<ExitCode> {
         .set("seed", a.seed)
         .set("algorithms", algorithms.iter().map(|x| x.name()).collect::<Vec<_>>().join(","))
         .set("encoding", &a.encoding)
+        .set("wall_tolerance", a.wall_tolerance)
         .set("tolerance", a.tolerance)
         .set("max_error_m", a.max_error_m)
         .set("max_error_deg", a.max_error_deg);
@@ -605,7 +610,13 @@ fn logs(a: LogsArgs) -> Result<ExitCode> {
         );
     }
     let encoding = if a.encoding == "paper" { MapEncoding::PAPER } else { MapEncoding::WALLS };
-    let score = ScoreParams { max_error_m: a.max_error_m, max_error_deg: a.max_error_deg, seed: a.seed, encoding };
+    let score = ScoreParams {
+        max_error_m: a.max_error_m,
+        max_error_deg: a.max_error_deg,
+        seed: a.seed,
+        encoding,
+        wall_tolerance_cells: a.wall_tolerance as usize,
+    };
     let mut rows: Vec<PairRow> = Vec::new();
     for (&(i, j), c) in &cross {
         for &alg in &algorithms {

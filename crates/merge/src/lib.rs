@@ -56,7 +56,7 @@ pub use refine::RefineParams;
 pub use report::MergeReport;
 pub use rmap::{CoverRule, OrientParams, RmapMerger, RmapParams, RmapResult, TriangleMatch, TriangleParams};
 pub use sift_merger::{SiftMerger, SiftMergerParams};
-pub use verify::{Agreement, VerifyParams, agreement};
+pub use verify::{Agreement, VerifyParams, agreement, agreement_within};
 
 /// Internals public only for the crate's tests and benches and the development probes (`dev/` in the
 /// repository): the R-map's maximal empty rectangles, wall ICP, wall hits, descriptor matching. Not part of

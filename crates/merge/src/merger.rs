@@ -3,7 +3,7 @@
 use crate::fuse::{FusionRule, fuse};
 use crate::refine::{RefineParams, refine, wall_points};
 use crate::report::MergeReport;
-use crate::verify::{Agreement, VerifyParams, agreement, ambiguity, confidence, rejection_reason};
+use crate::verify::{Agreement, VerifyParams, agreement_within, ambiguity, confidence, rejection_reason};
 use mrslam_core::Xyt;
 use mrslam_core::{OccupancyGrid, Pose2};
 use nalgebra::Point2;
@@ -144,7 +144,7 @@ fn check(
         add("refine", t);
     }
     let t = Instant::now();
-    let agr = agreement(a, b, &h.transform);
+    let agr = agreement_within(a, b, &h.transform, p.verify.wall_tolerance_cells);
     add("verify", t);
     let mut reason = if p.verify_enabled { rejection_reason(&p.verify, h.inliers, matches, &agr) } else { None };
     let mut ambiguous = None;
@@ -188,7 +188,7 @@ fn rival_reason(
         if apart <= p.verify.ambiguity_shift_m {
             continue;
         }
-        let agr = agreement(a, b, &h.transform);
+        let agr = agreement_within(a, b, &h.transform, p.verify.wall_tolerance_cells);
         if rejection_reason(&map_checks, 0, 0, &agr).is_none() && agr.wall_agreement() >= p.verify.max_rival_ratio * own
         {
             let (d_rot, d_xy) = pose_difference(&chosen.hypothesis.transform, &h.transform);

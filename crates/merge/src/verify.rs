@@ -32,10 +32,19 @@ pub struct VerifyParams {
     /// end to end. Only algorithms returning alternatives are affected; above 1 turns the check off.
     #[serde(default = "default_max_rival_ratio")]
     pub max_rival_ratio: f64,
+    /// A wall of b meets a wall of a ([`Agreement::walls_matched`]) when an occupied cell of a lies within this
+    /// many cells of it (in x and in y; 1: the 3x3 neighbourhood). Maps that two robots made have walls a
+    /// cell or two apart where the two SLAM runs disagree; cuts of one map do not.
+    #[serde(default = "default_wall_tolerance_cells")]
+    pub wall_tolerance_cells: usize,
 }
 
 fn default_max_rival_ratio() -> f64 {
     0.9
+}
+
+fn default_wall_tolerance_cells() -> usize {
+    1
 }
 
 impl Default for VerifyParams {
@@ -50,6 +59,7 @@ impl Default for VerifyParams {
             max_ambiguity: 0.85,
             ambiguity_shift_m: 1.0,
             max_rival_ratio: default_max_rival_ratio(),
+            wall_tolerance_cells: default_wall_tolerance_cells(),
         }
     }
 }
@@ -88,8 +98,14 @@ impl Agreement {
     }
 }
 
-/// Compares map `a` with map `b` placed in a's frame by `t_a_b`, over the cells of `a`.
+/// Compares map `a` with map `b` placed in a's frame by `t_a_b`, over the cells of `a`; a wall of b meets a
+/// wall of a within one cell.
 pub fn agreement(a: &OccupancyGrid, b: &OccupancyGrid, t_a_b: &Pose2) -> Agreement {
+    agreement_within(a, b, t_a_b, 1)
+}
+
+/// [`agreement`] with a wall of b meeting a wall of a within `tolerance` cells (in x and in y).
+pub fn agreement_within(a: &OccupancyGrid, b: &OccupancyGrid, t_a_b: &Pose2, tolerance: usize) -> Agreement {
     let cells = a.cells();
     let (w, h) = (a.width(), a.height());
     let occupied = |i: usize| CellState::from_log_odds(cells[i]) == CellState::Occupied;
@@ -108,8 +124,8 @@ pub fn agreement(a: &OccupancyGrid, b: &OccupancyGrid, t_a_b: &Pose2) -> Agreeme
         if sb == CellState::Occupied {
             r.walls += 1;
             let (x, y) = (i % w, i / w);
-            let near = (y.saturating_sub(1)..=(y + 1).min(h - 1))
-                .any(|yy| (x.saturating_sub(1)..=(x + 1).min(w - 1)).any(|xx| occupied(yy * w + xx)));
+            let near = (y.saturating_sub(tolerance)..=(y + tolerance).min(h - 1))
+                .any(|yy| (x.saturating_sub(tolerance)..=(x + tolerance).min(w - 1)).any(|xx| occupied(yy * w + xx)));
             r.walls_matched += near as usize;
         }
     });
@@ -255,8 +271,10 @@ mod tests {
         assert_eq!(shifted.disagree, 40);
         assert!(shifted.acceptance_index() < 0.9);
         assert_eq!(shifted.wall_agreement(), 0.0);
-        // one cell off still counts as meeting the wall
+        // one cell off still counts as meeting the wall; three cells off only with a tolerance of three
         assert_eq!(agreement(&g, &g, &pose(0.1, 0.0, 0.0)).wall_agreement(), 1.0);
+        assert_eq!(agreement_within(&g, &g, &pose(0.3, 0.0, 0.0), 2).wall_agreement(), 0.0);
+        assert_eq!(agreement_within(&g, &g, &pose(0.3, 0.0, 0.0), 3).wall_agreement(), 1.0);
     }
 
     #[test]

@@ -281,6 +281,8 @@ pub struct ScoreParams {
     pub seed: u64,
     /// The SIFT merger's map-to-image encoding.
     pub encoding: MapEncoding,
+    /// The verification gate's wall tolerance, cells ([`mrslam_merge::VerifyParams::wall_tolerance_cells`]).
+    pub wall_tolerance_cells: usize,
 }
 
 impl Default for ScoreParams {
@@ -290,6 +292,7 @@ impl Default for ScoreParams {
             max_error_deg: MAX_ERROR_DEG,
             seed: 0,
             encoding: MapEncoding::default(),
+            wall_tolerance_cells: mrslam_merge::VerifyParams::default().wall_tolerance_cells,
         }
     }
 }
@@ -426,7 +429,9 @@ pub fn merge_pair(
     let truth_error = median_error(&truth, cross).unwrap_or((f64::NAN, f64::NAN));
     let (overlap, overlap_smaller) = overlap(a, b, &truth);
     let merger = study_merger_encoded(algorithm, p.seed, p.encoding);
-    let out = merge(merger.as_ref(), a, b, &MergeParams::default());
+    let mut mp = MergeParams::default();
+    mp.verify.wall_tolerance_cells = p.wall_tolerance_cells;
+    let out = merge(merger.as_ref(), a, b, &mp);
     let r = out.report;
     let estimate = r.transform.map(|x| x.to_pose());
     let error = estimate.and_then(|e| median_error(&e, cross));
