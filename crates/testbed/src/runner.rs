@@ -193,6 +193,11 @@ pub fn run(scenario: &Scenario, mut opts: RunOptions) -> Result<RunOutput, RunEr
     if let Some(v) = opts.viz.as_deref_mut() {
         v.set_time(steps, merge_at);
     }
+    // A robot whose SLAM parameters ask for loop closure gets it when the drive ends, as `mrslam slam` does
+    // at the end of a log (no preset of the simulated robots turns it on).
+    for a in agents.iter_mut().filter(|a| a.slam.params().loop_closure) {
+        a.slam.close_loops();
+    }
     let evaluated = evaluate_robots(&agents, &truth, &mut opts)?;
     let (results, merges) = merge_maps(scenario, &algorithms, &evaluated, (&host, &other), &truth, &mut opts);
     let (oa, ob) = (&agents[0].observed, &agents[1].observed);
