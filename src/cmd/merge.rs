@@ -55,8 +55,8 @@ pub struct MergeArgs {
     #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u32).range(0..=4))]
     pub wall_dilation: u32,
     /// The verification gate's wall tolerance: a wall of map b meets a wall of map a within this many cells
-    /// (1: the 3x3 neighbourhood, the default; maps of two robots' SLAM runs may need 2).
-    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(0..=4))]
+    /// (1: the 3x3 neighbourhood, the gate before 2026-12-02; 2 lets the walls of two robots' SLAM runs meet).
+    #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u32).range(0..=4))]
     pub wall_tolerance: u32,
     /// Map-to-image encoding: `walls` (free and unknown alike) or `paper` (unknown grey).
     #[arg(long, default_value = "walls", value_parser = ["walls", "paper"])]

@@ -169,7 +169,9 @@ fn check(
 /// Why an accepted hypothesis is not trusted after all: a distinct later hypothesis that fits the maps as well.
 ///
 /// A rival need only pass the map checks (common cells, wall agreement, acceptance), not the feature-support
-/// ones: a self-similar map can be explained by two transforms with quite different inlier counts.
+/// ones: a self-similar map can be explained by two transforms with quite different inlier counts. Walls are
+/// compared within one cell here whatever `wall_tolerance_cells`: a wider tolerance lets a rival's misplaced
+/// walls meet a's, and tells the two transforms apart less.
 fn rival_reason(
     a: &OccupancyGrid,
     b: &OccupancyGrid,
@@ -178,8 +180,12 @@ fn rival_reason(
     rest: impl Iterator<Item = Hypothesis>,
     p: &MergeParams,
 ) -> Option<String> {
-    let map_checks = VerifyParams { min_inliers: 0, min_confidence: 0.0, ..p.verify };
-    let own = chosen.agreement.wall_agreement();
+    let map_checks = VerifyParams { min_inliers: 0, min_confidence: 0.0, wall_tolerance_cells: 1, ..p.verify };
+    let own = if p.verify.wall_tolerance_cells == 1 {
+        chosen.agreement.wall_agreement()
+    } else {
+        agreement_within(a, b, &chosen.hypothesis.transform, 1).wall_agreement()
+    };
     for mut h in rest {
         if p.refine.enabled {
             h.transform = refine(a, walls_b, &h.transform, &p.refine);
@@ -188,7 +194,7 @@ fn rival_reason(
         if apart <= p.verify.ambiguity_shift_m {
             continue;
         }
-        let agr = agreement_within(a, b, &h.transform, p.verify.wall_tolerance_cells);
+        let agr = agreement_within(a, b, &h.transform, 1);
         if rejection_reason(&map_checks, 0, 0, &agr).is_none() && agr.wall_agreement() >= p.verify.max_rival_ratio * own
         {
             let (d_rot, d_xy) = pose_difference(&chosen.hypothesis.transform, &h.transform);

@@ -155,6 +155,44 @@ fn main() {
         println!("sift ok/false/refused {:?}, correlative {:?}", stats[0], stats[1]);
         return;
     }
+    if args.first().is_some_and(|s| s == "gap") {
+        // Gap pairs (nothing shared) and low-overlap pairs of generated plans: what separates a coincidence
+        // from a true answer? Prints one line per pair: kind, size, seed, accepted (tolerance 1 / 2), error,
+        // the best answer's matched walls and the runner-up's.
+        let cor = CorrelativeMerger::new(p);
+        for (w, h) in [(18.0, 14.0), (24.0, 18.0)] {
+            for seed in 0..60u64 {
+                let map =
+                    generate(seed % 8, &FloorplanParams { width_m: w, height_m: h, ..FloorplanParams::default() });
+                for overlap in [0.0, 0.1, 0.2] {
+                    let pair = cut_pair(&map, &PairSpec { overlap, max_shift_m: 5.0, rotate: true }, 1000 + seed);
+                    let Ok(al) = cor.align(&pair.a, &pair.b) else {
+                        println!("{overlap} {w}x{h} {seed} none");
+                        continue;
+                    };
+                    let mut acc = Vec::new();
+                    for tol in [1usize, 2] {
+                        let mut mp = MergeParams::default();
+                        mp.verify.wall_tolerance_cells = tol;
+                        acc.push(merge(&cor, &pair.a, &pair.b, &mp).report.accepted);
+                    }
+                    let (d, deg) = error(&al.transform, &pair.t_a_b);
+                    let second = al.alternatives.first().map_or(0, |h| h.inliers);
+                    let agr = mrslam_merge::agreement_within(&pair.a, &pair.b, &al.transform, 2);
+                    println!(
+                        "{overlap} {w}x{h} {seed} acc {:?} err {d:.3} {deg:.2} inl {} second {second} matches {} common {} walls2 {:.3} omega {:.3}",
+                        acc,
+                        al.inliers,
+                        al.matches,
+                        agr.common(),
+                        agr.wall_agreement(),
+                        agr.acceptance_index()
+                    );
+                }
+            }
+        }
+        return;
+    }
     let a = read_ros_map(args[0].as_ref()).expect("map a");
     let b = read_ros_map(args[1].as_ref()).expect("map b");
     let mut rest = &args[2..];
