@@ -133,6 +133,43 @@ fn bad_destinations_fail_before_the_run() {
     assert_eq!(o.status.code(), Some(1), "{e}");
     assert!(e.contains("pip install rerun-sdk==0.36.3"), "{e}");
 
+    // --spawn with a viewer on PATH that cannot show a window: refused before the run, saying why.
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        let fake = d.join("fake-viewer");
+        std::fs::create_dir_all(&fake).unwrap();
+        let exe = fake.join("rerun");
+        std::fs::write(&exe, "#!/bin/sh\nexit 0\n").unwrap();
+        std::fs::set_permissions(&exe, std::fs::Permissions::from_mode(0o755)).unwrap();
+        let spawn = |display: Option<&str>| {
+            let mut c = Command::new(env!("CARGO_BIN_EXE_mrslam"));
+            c.args(["run", p(&scenario), "--quiet", "--out", p(&out), "--spawn"]).env("PATH", &fake);
+            c.env_remove("DISPLAY").env_remove("WAYLAND_DISPLAY");
+            if let Some(v) = display {
+                c.env("DISPLAY", v);
+            }
+            c.output().unwrap()
+        };
+        if cfg!(target_os = "linux") {
+            let o = spawn(None);
+            let e = text(&o.stderr);
+            assert_eq!(o.status.code(), Some(1), "{e}");
+            assert!(e.contains("no display") && e.contains("--rrd FILE"), "{e}");
+            assert!(!out.join("report.json").exists(), "the run went ahead");
+        }
+        // A display, but the viewer exits at once (as one that cannot open it does): refused once it is plain
+        // that nothing listens, not after the run.
+        let start = std::time::Instant::now();
+        let o = spawn(Some(":99"));
+        let e = text(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "{e}");
+        assert!(e.contains("--spawn"), "{e}");
+        assert!(!e.contains("panicked"), "{e}");
+        assert!(!out.join("report.json").exists(), "the run went ahead");
+        assert!(start.elapsed().as_secs() < 60, "refused only after {:?}", start.elapsed());
+    }
+
     // --connect where no viewer listens (a port just freed) fails at once instead of waiting for one.
     let port = std::net::TcpListener::bind("127.0.0.1:0").unwrap().local_addr().unwrap().port();
     let addr = format!("127.0.0.1:{port}");

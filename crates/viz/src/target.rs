@@ -52,8 +52,21 @@ impl Target {
                 if find_on_path("rerun").is_none() {
                     return Err(VizError::NoViewer);
                 }
+                if let Some(why) = no_display() {
+                    return Err(VizError::Spawn(why));
+                }
                 let info = rerun::spawn(&rerun::SpawnOptions::default()).map_err(|e| VizError::Spawn(e.to_string()))?;
-                grpc(&format!("rerun+http://127.0.0.1:{}/proxy", info.port))
+                let url = format!("rerun+http://127.0.0.1:{}/proxy", info.port);
+                // A viewer that cannot open a window exits at once; the gRPC sink would only find out when the
+                // work is done and the recording is flushed. Wait here until it listens.
+                wait_for_viewer(&url).map_err(|cause| {
+                    VizError::Spawn(format!(
+                        "the viewer started but does not answer at {url} after {} s ({cause}); record to a file \
+                         with --rrd FILE and open it with `rerun FILE`",
+                        SPAWN_TIMEOUT.as_secs()
+                    ))
+                })?;
+                grpc(&url)
             }
             Target::Connect(url) => {
                 // The gRPC sink connects lazily and waits for a viewer without end: find out now.
@@ -66,6 +79,33 @@ impl Target {
 
 /// How long `--connect` waits for a viewer to answer.
 const PROBE_TIMEOUT: Duration = Duration::from_secs(3);
+/// How long `--spawn` waits for the viewer it started to listen.
+const SPAWN_TIMEOUT: Duration = Duration::from_secs(10);
+
+/// Why no viewer window can open here, when that is plain before trying: on Linux, neither `DISPLAY` nor
+/// `WAYLAND_DISPLAY` is set.
+fn no_display() -> Option<String> {
+    let set = |name: &str| std::env::var_os(name).is_some_and(|v| !v.is_empty());
+    (cfg!(target_os = "linux") && !set("DISPLAY") && !set("WAYLAND_DISPLAY")).then(|| {
+        "no display to open a viewer window on (neither DISPLAY nor WAYLAND_DISPLAY is set); record to a file \
+         with --rrd FILE and open it with `rerun FILE` where there is a display, or stream to a viewer running \
+         elsewhere with --connect HOST:PORT"
+            .to_string()
+    })
+}
+
+/// Polls the viewer at `url` until it accepts connections or [`SPAWN_TIMEOUT`] passes.
+fn wait_for_viewer(url: &str) -> Result<(), String> {
+    let start = std::time::Instant::now();
+    loop {
+        match probe(url) {
+            Ok(()) => return Ok(()),
+            Err(VizError::NoViewerAt { cause, .. }) if start.elapsed() >= SPAWN_TIMEOUT => return Err(cause),
+            Err(e) if start.elapsed() >= SPAWN_TIMEOUT => return Err(e.to_string()),
+            Err(_) => std::thread::sleep(Duration::from_millis(200)),
+        }
+    }
+}
 
 /// Fails unless something accepts TCP connections at the host and port of `url`.
 fn probe(url: &str) -> Result<(), VizError> {
