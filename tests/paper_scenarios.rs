@@ -26,7 +26,16 @@ fn run_scenario(name: &str) -> RunReport {
     }
     let dir = tempfile::tempdir().unwrap();
     write_outputs(&out, dir.path()).unwrap();
-    for f in ["experia.yaml", "experia.pgm", "prawn.yaml", "truth.yaml", "report.json"] {
+    for f in [
+        "experia.yaml",
+        "experia.pgm",
+        "experia.png",
+        "prawn.yaml",
+        "prawn.png",
+        "truth.yaml",
+        "truth.png",
+        "report.json",
+    ] {
         assert!(dir.path().join(f).exists(), "{f} not written");
     }
     eprint!("{}", out.report.summary());

@@ -103,8 +103,8 @@ pub fn run(cmd: MapCommand) -> Result<ExitCode> {
             if overlap > 0.0 && pair.overlap == 0.0 {
                 bail!("{}: the halves share no known cell although --overlap is {overlap}", map.display());
             }
-            map_io::write_ros_map(&pair.a, &a)?;
-            map_io::write_ros_map(&pair.b, &b)?;
+            map_io::write_ros_map_with_preview(&pair.a, &a)?;
+            map_io::write_ros_map_with_preview(&pair.b, &b)?;
             let Xyt { x, y, theta: th } = Xyt::from_pose(&pair.t_a_b);
             println!("wrote {} and {} (overlap {:.3})", a.display(), b.display(), pair.overlap);
             println!("true transform b -> a: x {x:.4} m, y {y:.4} m, theta {th:.5} rad ({:.3} deg)", th.to_degrees());
@@ -137,7 +137,7 @@ pub fn load_map(path: &Path, resolution: f64) -> Result<OccupancyGrid> {
 /// Saves a map as YAML+PGM, or as a bare trinary PGM or PNG, by the path's extension.
 pub fn save_map(grid: &OccupancyGrid, path: &Path) -> Result<()> {
     match extension(path).as_str() {
-        "yaml" | "yml" => map_io::write_ros_map(grid, path)?,
+        "yaml" | "yml" => map_io::write_ros_map_with_preview(grid, path)?,
         "pgm" => map_io::write_file_atomic(path, &map_io::encode_pgm(&map_io::grid_to_image(grid)))?,
         "png" => {
             let img: GreyImage = map_io::grid_to_image(grid);

@@ -161,7 +161,7 @@ pub fn run(args: MergeArgs) -> Result<ExitCode> {
     }
     match (&out.merged, &args.output) {
         (Some(g), Some(path)) => {
-            map_io::write_ros_map(g, path)?;
+            map_io::write_ros_map_with_preview(g, path)?;
             println!("merged map: {} ({}x{} cells)", path.display(), g.width(), g.height());
         }
         (None, Some(path)) => println!("merged map: not written to {} (merge rejected)", path.display()),

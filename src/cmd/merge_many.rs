@@ -40,7 +40,7 @@ pub fn run(args: &MergeArgs, mut maps: Vec<OccupancyGrid>, merger: &dyn Merger, 
     print!("{}", summary(&out.report, &files));
     match (&out.merged, &args.output) {
         (Some(g), Some(path)) => {
-            map_io::write_ros_map(g, path)?;
+            map_io::write_ros_map_with_preview(g, path)?;
             let joined = out.report.maps - out.report.not_connected.len();
             println!(
                 "merged map: {} ({}x{} cells, {joined} of {} maps)",

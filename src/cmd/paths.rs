@@ -47,11 +47,12 @@ fn is_map_yaml(path: &Path) -> bool {
     matches!(extension(path).as_str(), "yaml" | "yml")
 }
 
-/// The files that writing `path` creates: itself, and for a map YAML the PGM beside it.
+/// The files that writing `path` creates: itself, and for a map YAML the PGM and the PNG preview beside it.
 pub fn written_files(path: &Path) -> Vec<PathBuf> {
     let mut files = vec![path.to_path_buf()];
     if is_map_yaml(path) {
         files.push(path.with_extension("pgm"));
+        files.push(map_io::preview_path(path));
     }
     files
 }

@@ -159,7 +159,7 @@ pub fn run(args: SlamArgs) -> Result<ExitCode> {
     bar.finish_and_clear();
     let secs = start.elapsed().as_secs_f64();
     let map = filter.map().context("building the map")?;
-    map_io::write_ros_map(&map, &args.output).with_context(|| format!("{}", args.output.display()))?;
+    map_io::write_ros_map_with_preview(&map, &args.output).with_context(|| format!("{}", args.output.display()))?;
 
     // A pose for every scan: the filter's at the processed ones, odometry in between.
     let (poses, processed, loops) = (run.poses, run.processed, run.loop_closure);

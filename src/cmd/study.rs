@@ -552,7 +552,8 @@ fn logs(a: LogsArgs) -> Result<ExitCode> {
             bar.set_message(format!("part {k}/{}", a.parts));
             let part = logs::map_part(scans, &slam, a.seed, &a.log, &mut || bar.inc(1))?;
             bar.finish_and_clear();
-            map_io::write_ros_map(&part.map, &map_path).with_context(|| format!("{}", map_path.display()))?;
+            map_io::write_ros_map_with_preview(&part.map, &map_path)
+                .with_context(|| format!("{}", map_path.display()))?;
             let header = format!(
                 "mrslam study logs: part {k} of {} of {} (lines {} to {}), one pose per scan, `stamp x y theta`, \
                  in the part's map frame ({} scans processed by the filter, the others placed by odometry)",

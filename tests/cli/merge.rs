@@ -47,6 +47,10 @@ fn cut_then_merge_recovers_the_printed_transform() {
     assert!((t["theta"].as_f64().unwrap() - tth).abs() < 0.02, "{t} vs {truth:?}");
     let merged = read_ros_map(&d.join("merged.yaml")).unwrap();
     assert!(merged.state_counts().0 > read_ros_map(&d.join("a.yaml")).unwrap().state_counts().0);
+    // The preview beside it: the merged map cropped to its known cells.
+    let preview = image::open(d.join("merged.png")).unwrap();
+    assert!(preview.width() <= merged.width() as u32 && preview.height() <= merged.height() as u32);
+    assert!(preview.width() > 50 && preview.height() > 50);
     let png = image::open(d.join("matches.png")).unwrap();
     assert!(png.width() > 100 && png.height() > 100);
 }
@@ -75,7 +79,7 @@ fn rejected_merge_exits_2_and_writes_no_map() {
     ]);
     assert_eq!(o.status.code(), Some(2), "{}{}", text(&o.stdout), text(&o.stderr));
     assert!(text(&o.stdout).contains("REJECTED") && text(&o.stdout).contains("reason:"));
-    assert!(!d.join("merged.yaml").exists() && !d.join("merged.pgm").exists());
+    assert!(!d.join("merged.yaml").exists() && !d.join("merged.pgm").exists() && !d.join("merged.png").exists());
     let report: serde_json::Value = serde_json::from_slice(&std::fs::read(d.join("report.json")).unwrap()).unwrap();
     assert_eq!(report["accepted"], false);
     assert!(report["reason"].as_str().is_some_and(|r| !r.is_empty()));

@@ -112,6 +112,7 @@ fn a_log_split_into_two_robots_is_mapped_merged_scored_and_resumed() {
         "parts.csv",
         "part-0.yaml",
         "part-0.pgm",
+        "part-0.png",
         "part-0.trajectory.txt",
         "part-1.yaml",
         "part-1.pgm",

@@ -559,6 +559,50 @@ pub fn write_ros_map(grid: &OccupancyGrid, yaml_path: &Path) -> Result<(), MapIo
     write_file_atomic(yaml_path, map_yaml_text(grid, &image_name).as_bytes())
 }
 
+/// Cells of margin a preview keeps around the map's known cells.
+const PREVIEW_MARGIN: usize = 10;
+
+/// Where the preview of the map `yaml_path` goes: beside it, the same name with `.png`.
+pub fn preview_path(yaml_path: &Path) -> PathBuf {
+    yaml_path.with_extension("png")
+}
+
+/// A picture of a grid for a person: its trinary image (occupied black, free white, unknown grey) cropped to the
+/// known cells and a margin of 10 cells.
+pub fn preview_image(grid: &OccupancyGrid) -> GreyImage {
+    let full = grid_to_image(grid);
+    let (w, h) = (full.width, full.height);
+    let (mut x0, mut y0, mut x1, mut y1) = (w, h, 0, 0);
+    for (i, &v) in full.pixels.iter().enumerate() {
+        if v != PGM_UNKNOWN {
+            let (x, y) = (i % w, i / w);
+            x0 = x0.min(x);
+            y0 = y0.min(y);
+            x1 = x1.max(x);
+            y1 = y1.max(y);
+        }
+    }
+    if x0 > x1 {
+        return full;
+    }
+    let (x0, y0) = (x0.saturating_sub(PREVIEW_MARGIN), y0.saturating_sub(PREVIEW_MARGIN));
+    let (x1, y1) = ((x1 + PREVIEW_MARGIN).min(w - 1), (y1 + PREVIEW_MARGIN).min(h - 1));
+    let pixels = (y0..=y1).flat_map(|y| full.pixels[y * w + x0..=y * w + x1].iter().copied()).collect();
+    GreyImage { width: x1 - x0 + 1, height: y1 - y0 + 1, pixels }
+}
+
+/// Writes [`preview_image`] of `grid` as a PNG at `png_path` (through a temporary name).
+pub fn write_map_preview(grid: &OccupancyGrid, png_path: &Path) -> Result<(), MapIoError> {
+    write_file_atomic(png_path, &encode_png(&preview_image(grid), png_path)?)
+}
+
+/// [`write_ros_map`], then the map's PNG preview beside it ([`preview_path`]): what the command line and the
+/// testbed write for every map, so that a person can look at it without a viewer.
+pub fn write_ros_map_with_preview(grid: &OccupancyGrid, yaml_path: &Path) -> Result<(), MapIoError> {
+    write_ros_map(grid, yaml_path)?;
+    write_map_preview(grid, &preview_path(yaml_path))
+}
+
 /// The YAML text map_server reads for `grid` stored in `image_name`.
 pub fn map_yaml_text(grid: &OccupancyGrid, image_name: &str) -> String {
     let o: &Pose2 = grid.origin();
@@ -595,6 +639,30 @@ pub fn write_file_atomic(path: &Path, bytes: &[u8]) -> Result<(), MapIoError> {
 mod tests {
     use super::*;
     use crate::grid::LogOddsParams;
+
+    #[test]
+    fn a_preview_is_the_map_cropped_to_its_known_cells() {
+        let mut g = OccupancyGrid::new(100, 80, 0.05, crate::pose(0.0, 0.0, 0.0)).unwrap();
+        for iy in 30..40 {
+            for ix in 20..50 {
+                g.set(ix, iy, if ix == 20 { 2.0 } else { -2.0 });
+            }
+        }
+        let img = preview_image(&g);
+        assert_eq!((img.width, img.height), (30 + 20, 10 + 20));
+        // the wall column, 10 pixels in from the left, is black; the corner of the margin is unknown grey
+        assert_eq!(img.pixels[15 * img.width + 10], PGM_OCCUPIED);
+        assert_eq!(img.pixels[15 * img.width + 11], PGM_FREE);
+        assert_eq!(img.pixels[0], PGM_UNKNOWN);
+        let dir = tempfile::tempdir().unwrap();
+        let yaml = dir.path().join("m.yaml");
+        write_ros_map_with_preview(&g, &yaml).unwrap();
+        let png = read_grey_image(&preview_path(&yaml)).unwrap();
+        assert_eq!((png.width, png.height, png.pixels), (img.width, img.height, img.pixels));
+        // an empty map's preview is the whole (unknown) image
+        let empty = OccupancyGrid::new(7, 5, 0.05, crate::pose(0.0, 0.0, 0.0)).unwrap();
+        assert_eq!((preview_image(&empty).width, preview_image(&empty).height), (7, 5));
+    }
 
     fn yaml(text: &str) -> Result<MapYaml, MapIoError> {
         parse_map_yaml(text, Path::new("m.yaml"))

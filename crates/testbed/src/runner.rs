@@ -475,21 +475,23 @@ fn expected_end(scenario: &Scenario, sim: &Sim, agents: &[Agent], t: f64) -> f64
     }
 }
 
-/// Writes a run's maps (PGM+YAML), the true map, merged maps and `report.json` (last) into `dir`.
+/// Writes a run's maps (YAML+PGM, each with a PNG preview), the true map, merged maps and `report.json` (last)
+/// into `dir`.
 pub fn write_outputs(out: &RunOutput, dir: &Path) -> Result<(), RunError> {
     std::fs::create_dir_all(dir).map_err(|cause| MapIoError::Io { path: dir.to_path_buf(), cause })?;
     for (name, map) in &out.maps {
-        map_io::write_ros_map(map, &dir.join(format!("{name}.yaml")))?;
+        map_io::write_ros_map_with_preview(map, &dir.join(format!("{name}.yaml")))?;
     }
-    map_io::write_ros_map(&out.truth, &dir.join("truth.yaml"))?;
+    map_io::write_ros_map_with_preview(&out.truth, &dir.join("truth.yaml"))?;
     for m in &out.merges {
         let path = dir.join(format!("merged_{}.yaml", m.report.algorithm));
         match &m.merged {
-            Some(g) => map_io::write_ros_map(g, &path)?,
+            Some(g) => map_io::write_ros_map_with_preview(g, &path)?,
             None => {
                 // A rejected merge leaves no map, not even a stale one from an earlier run.
                 let _ = std::fs::remove_file(&path);
                 let _ = std::fs::remove_file(path.with_extension("pgm"));
+                let _ = std::fs::remove_file(map_io::preview_path(&path));
             }
         }
     }
