@@ -159,13 +159,17 @@ pub fn run(args: SlamArgs) -> Result<ExitCode> {
     bar.finish_and_clear();
     let secs = start.elapsed().as_secs_f64();
     let map = filter.map().context("building the map")?;
-    map_io::write_ros_map_with_preview(&map, &args.output).with_context(|| format!("{}", args.output.display()))?;
+    map_io::write_ros_map(&map, &args.output).with_context(|| format!("{}", args.output.display()))?;
 
     // A pose for every scan: the filter's at the processed ones, odometry in between.
     let (poses, processed, loops) = (run.poses, run.processed, run.loop_closure);
     let stamps: Vec<f64> = log.scans.iter().map(|r| r.scan.stamp).collect();
     let trajectory: Vec<StampedPose> =
         stamps.iter().zip(&poses).map(|(&stamp, &pose)| StampedPose { stamp, pose }).collect();
+    // The preview beside the map: the map with the best particle's path (a pose per scan) in red.
+    let path: Vec<nalgebra::Point2<f64>> = poses.iter().map(|p| p.translation.vector.into()).collect();
+    let preview = map_io::preview_path(&args.output);
+    map_io::write_map_preview_with_path(&map, &path, &preview).with_context(|| format!("{}", preview.display()))?;
     if let Some(path) = &args.trajectory {
         let header = format!(
             "mrslam slam {}: one pose per scan ({} scans), `stamp x y theta`, the best particle's robot pose in \

@@ -84,7 +84,9 @@ fn maps_a_drifting_log_and_beats_its_odometry() {
     // The drift the log was made with: 1/1.03 - 1 = -2.9 % and -0.0097 rad/m (a short run: roughly).
     assert!(out.contains("odometry calibration learnt: distance scale -"), "{out}");
     let grid = mrslam_core::map_io::read_ros_map(&map).expect("the map reads back");
-    assert!(dir.path().join("office.png").is_file(), "the map's preview beside it");
+    // The preview beside it: in colour, with the path drawn in red.
+    let preview = image::open(dir.path().join("office.png")).expect("the map's preview beside it").to_rgb8();
+    assert!(preview.pixels().filter(|p| p.0 == [220, 30, 30]).count() > 100, "the path is drawn");
     let (free, occupied, _) = grid.state_counts();
     assert!(free > 10 * occupied && occupied > 200, "free {free} occupied {occupied}");
     let rows: Vec<(f64, f64, f64)> = std::fs::read_to_string(&traj)

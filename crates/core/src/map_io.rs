@@ -12,6 +12,7 @@
 
 use crate::grid::{CellState, GridError, MAX_CELLS, OccupancyGrid};
 use crate::se2::{Pose2, pose};
+use nalgebra::Point2;
 use std::fmt::Write as _;
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
@@ -567,13 +568,12 @@ pub fn preview_path(yaml_path: &Path) -> PathBuf {
     yaml_path.with_extension("png")
 }
 
-/// A picture of a grid for a person: its trinary image (occupied black, free white, unknown grey) cropped to the
-/// known cells and a margin of 10 cells.
-pub fn preview_image(grid: &OccupancyGrid) -> GreyImage {
-    let full = grid_to_image(grid);
-    let (w, h) = (full.width, full.height);
+/// The pixel box (x0, y0, x1, y1, inclusive, top row 0) of a grid's image that its preview keeps: the known cells
+/// and a margin of 10 cells; the whole image when no cell is known.
+fn preview_box(img: &GreyImage) -> (usize, usize, usize, usize) {
+    let (w, h) = (img.width, img.height);
     let (mut x0, mut y0, mut x1, mut y1) = (w, h, 0, 0);
-    for (i, &v) in full.pixels.iter().enumerate() {
+    for (i, &v) in img.pixels.iter().enumerate() {
         if v != PGM_UNKNOWN {
             let (x, y) = (i % w, i / w);
             x0 = x0.min(x);
@@ -583,12 +583,69 @@ pub fn preview_image(grid: &OccupancyGrid) -> GreyImage {
         }
     }
     if x0 > x1 {
-        return full;
+        return (0, 0, w.saturating_sub(1), h.saturating_sub(1));
     }
     let (x0, y0) = (x0.saturating_sub(PREVIEW_MARGIN), y0.saturating_sub(PREVIEW_MARGIN));
-    let (x1, y1) = ((x1 + PREVIEW_MARGIN).min(w - 1), (y1 + PREVIEW_MARGIN).min(h - 1));
+    (x0, y0, (x1 + PREVIEW_MARGIN).min(w - 1), (y1 + PREVIEW_MARGIN).min(h - 1))
+}
+
+/// A picture of a grid for a person: its trinary image (occupied black, free white, unknown grey) cropped to the
+/// known cells and a margin of 10 cells.
+pub fn preview_image(grid: &OccupancyGrid) -> GreyImage {
+    let full = grid_to_image(grid);
+    if full.pixels.is_empty() {
+        return full;
+    }
+    let (x0, y0, x1, y1) = preview_box(&full);
+    let w = full.width;
     let pixels = (y0..=y1).flat_map(|y| full.pixels[y * w + x0..=y * w + x1].iter().copied()).collect();
     GreyImage { width: x1 - x0 + 1, height: y1 - y0 + 1, pixels }
+}
+
+/// [`preview_image`] in colour with a path drawn over it in red: `path` is a sequence of points in the map frame
+/// (metres), joined by straight lines; points off the picture are clipped.
+pub fn preview_with_path(grid: &OccupancyGrid, path: &[Point2<f64>]) -> image::RgbImage {
+    let full = grid_to_image(grid);
+    let mut out = image::RgbImage::new(1, 1);
+    if full.pixels.is_empty() {
+        return out;
+    }
+    let (x0, y0, x1, y1) = preview_box(&full);
+    let (w, h) = (x1 - x0 + 1, y1 - y0 + 1);
+    out = image::RgbImage::from_fn(w as u32, h as u32, |x, y| {
+        let v = full.pixels[(y as usize + y0) * full.width + x as usize + x0];
+        image::Rgb([v, v, v])
+    });
+    // a point's pixel (fractional), top row 0, in the cropped picture
+    let pixel = |p: &Point2<f64>| {
+        let (cx, cy) = grid.world_to_cell_f(p);
+        (cx - x0 as f64, (full.height as f64 - cy) - y0 as f64)
+    };
+    for pair in path.windows(2) {
+        let (a, b) = (pixel(&pair[0]), pixel(&pair[1]));
+        let steps = ((b.0 - a.0).abs().max((b.1 - a.1).abs()).ceil() as usize).clamp(1, 100_000);
+        for k in 0..=steps {
+            let t = k as f64 / steps as f64;
+            let (x, y) = (a.0 + t * (b.0 - a.0), a.1 + t * (b.1 - a.1));
+            if x >= 0.0 && y >= 0.0 && (x as usize) < w && (y as usize) < h {
+                out.put_pixel(x as u32, y as u32, image::Rgb([220, 30, 30]));
+            }
+        }
+    }
+    out
+}
+
+/// Writes [`preview_with_path`] as a PNG at `png_path` (through a temporary name).
+pub fn write_map_preview_with_path(
+    grid: &OccupancyGrid,
+    path: &[Point2<f64>],
+    png_path: &Path,
+) -> Result<(), MapIoError> {
+    let img = preview_with_path(grid, path);
+    let mut bytes = Vec::new();
+    img.write_to(&mut std::io::Cursor::new(&mut bytes), image::ImageFormat::Png)
+        .map_err(|e| MapIoError::Image { path: png_path.to_path_buf(), message: e.to_string() })?;
+    write_file_atomic(png_path, &bytes)
 }
 
 /// Writes [`preview_image`] of `grid` as a PNG at `png_path` (through a temporary name).
@@ -662,6 +719,14 @@ mod tests {
         // an empty map's preview is the whole (unknown) image
         let empty = OccupancyGrid::new(7, 5, 0.05, crate::pose(0.0, 0.0, 0.0)).unwrap();
         assert_eq!((preview_image(&empty).width, preview_image(&empty).height), (7, 5));
+        // A path along the free strip, from cell (25, 35) to (45, 35): red on that row, 11 px from the top.
+        let path = [Point2::new(25.5 * 0.05, 35.5 * 0.05), Point2::new(45.5 * 0.05, 35.5 * 0.05)];
+        let rgb = preview_with_path(&g, &path);
+        assert_eq!((rgb.width() as usize, rgb.height() as usize), (img.width, img.height));
+        let row = (80 - 35 - 1) - (80 - 40 - 10); // the cell row's pixel row in the crop
+        assert_eq!(rgb.get_pixel(15, row as u32).0, [220, 30, 30]);
+        assert_eq!(rgb.get_pixel(35, row as u32).0, [220, 30, 30]);
+        assert_eq!(rgb.get_pixel(15, row as u32 + 2).0, [PGM_FREE; 3]);
     }
 
     fn yaml(text: &str) -> Result<MapYaml, MapIoError> {
