@@ -38,6 +38,31 @@ fn run_scenario(name: &str) -> RunReport {
     ] {
         assert!(dir.path().join(f).exists(), "{f} not written");
     }
+    // The picture of each accepted merge: the second robot's walls, placed by the estimate, lie on the truth's.
+    let base = mrslam_core::map_io::overlay(&out.truth, &[]);
+    for m in out.merges.iter().filter(|m| m.report.accepted) {
+        let picture = dir.path().join(format!("overlay_{}.png", m.report.algorithm));
+        assert!(picture.exists(), "{} not written", picture.display());
+        let over = mrslam_testbed::runner::merge_overlay(&out, &m.report.transform.unwrap().to_pose());
+        let near_truth_wall = |x: u32, y: u32| {
+            (x.saturating_sub(2)..=x + 2).any(|xx| {
+                (y.saturating_sub(2)..=y + 2).any(|yy| base.get_pixel_checked(xx, yy).is_some_and(|p| p.0 == [150; 3]))
+            })
+        };
+        let placed: Vec<(u32, u32)> =
+            over.enumerate_pixels().filter(|(_, _, p)| p.0 == [235, 120, 20]).map(|(x, y, _)| (x, y)).collect();
+        let on = placed.iter().filter(|&&(x, y)| near_truth_wall(x, y)).count();
+        let share = on as f64 / placed.len().max(1) as f64;
+        eprintln!(
+            "{name}: {} of the second map's {} wall pixels within 2 px of a true wall ({share:.2})",
+            on,
+            placed.len()
+        );
+        assert!(
+            placed.len() > 100 && share > 0.8,
+            "{name}: the overlay does not lay the second map on the truth: {share}"
+        );
+    }
     eprint!("{}", out.report.summary());
     out.report
 }

@@ -635,17 +635,85 @@ pub fn preview_with_path(grid: &OccupancyGrid, path: &[Point2<f64>]) -> image::R
     out
 }
 
+/// One map laid over another in [`overlay`]: its occupied cells and a path, placed in the base map's frame.
+#[derive(Debug, Clone, Copy)]
+pub struct OverlayLayer<'a> {
+    /// The map whose occupied cells are drawn.
+    pub map: &'a OccupancyGrid,
+    /// Where the map's frame lies in the base map's frame.
+    pub placement: Pose2,
+    /// A path in the map's frame, drawn as lines.
+    pub path: &'a [Pose2],
+    /// Colour of the occupied cells; the path is drawn in a darker shade of it.
+    pub colour: [u8; 3],
+}
+
+/// A picture of maps laid over a base map (the truth, say): the base in light greys, each layer's occupied cells
+/// in its colour at its placement, each layer's path in a darker shade; cropped as [`preview_image`] crops the
+/// base. Where the placements are right, the layers' walls cover the base's.
+pub fn overlay(base: &OccupancyGrid, layers: &[OverlayLayer]) -> image::RgbImage {
+    let full = grid_to_image(base);
+    if full.pixels.is_empty() {
+        return image::RgbImage::new(1, 1);
+    }
+    let (x0, y0, x1, y1) = preview_box(&full);
+    let (w, h) = (x1 - x0 + 1, y1 - y0 + 1);
+    let mut out = image::RgbImage::from_fn(w as u32, h as u32, |x, y| {
+        let v = match full.pixels[(y as usize + y0) * full.width + x as usize + x0] {
+            PGM_OCCUPIED => 150,
+            PGM_FREE => 245,
+            _ => 215,
+        };
+        image::Rgb([v, v, v])
+    });
+    let pixel = |p: &Point2<f64>| {
+        let (cx, cy) = base.world_to_cell_f(p);
+        (cx - x0 as f64, (full.height as f64 - cy) - y0 as f64)
+    };
+    let mut put = |x: f64, y: f64, c: [u8; 3]| {
+        if x >= 0.0 && y >= 0.0 && (x as usize) < w && (y as usize) < h {
+            out.put_pixel(x as u32, y as u32, image::Rgb(c));
+        }
+    };
+    for layer in layers {
+        let m = layer.map;
+        for iy in 0..m.height() {
+            for ix in 0..m.width() {
+                if m.state(ix, iy) == CellState::Occupied {
+                    let (x, y) = pixel(&(layer.placement * m.cell_center(ix as i64, iy as i64)));
+                    put(x, y, layer.colour);
+                }
+            }
+        }
+        let dark = layer.colour.map(|c| c / 2);
+        for pair in layer.path.windows(2) {
+            let a = pixel(&(layer.placement * Point2::from(pair[0].translation.vector)));
+            let b = pixel(&(layer.placement * Point2::from(pair[1].translation.vector)));
+            let steps = ((b.0 - a.0).abs().max((b.1 - a.1).abs()).ceil() as usize).clamp(1, 100_000);
+            for k in 0..=steps {
+                let t = k as f64 / steps as f64;
+                put(a.0 + t * (b.0 - a.0), a.1 + t * (b.1 - a.1), dark);
+            }
+        }
+    }
+    out
+}
+
+/// Writes an RGB picture as a PNG at `png_path` (through a temporary name).
+pub fn write_rgb_png(img: &image::RgbImage, png_path: &Path) -> Result<(), MapIoError> {
+    let mut bytes = Vec::new();
+    img.write_to(&mut std::io::Cursor::new(&mut bytes), image::ImageFormat::Png)
+        .map_err(|e| MapIoError::Image { path: png_path.to_path_buf(), message: e.to_string() })?;
+    write_file_atomic(png_path, &bytes)
+}
+
 /// Writes [`preview_with_path`] as a PNG at `png_path` (through a temporary name).
 pub fn write_map_preview_with_path(
     grid: &OccupancyGrid,
     path: &[Point2<f64>],
     png_path: &Path,
 ) -> Result<(), MapIoError> {
-    let img = preview_with_path(grid, path);
-    let mut bytes = Vec::new();
-    img.write_to(&mut std::io::Cursor::new(&mut bytes), image::ImageFormat::Png)
-        .map_err(|e| MapIoError::Image { path: png_path.to_path_buf(), message: e.to_string() })?;
-    write_file_atomic(png_path, &bytes)
+    write_rgb_png(&preview_with_path(grid, path), png_path)
 }
 
 /// Writes [`preview_image`] of `grid` as a PNG at `png_path` (through a temporary name).
@@ -727,6 +795,17 @@ mod tests {
         assert_eq!(rgb.get_pixel(15, row as u32).0, [220, 30, 30]);
         assert_eq!(rgb.get_pixel(35, row as u32).0, [220, 30, 30]);
         assert_eq!(rgb.get_pixel(15, row as u32 + 2).0, [PGM_FREE; 3]);
+        // The map laid over itself, placed right: its wall cells in the layer's colour where the base's are.
+        let layer = OverlayLayer { map: &g, placement: Pose2::identity(), path: &[], colour: [0, 0, 255] };
+        let over = overlay(&g, &[layer]);
+        assert_eq!((over.width() as usize, over.height() as usize), (img.width, img.height));
+        assert_eq!(over.get_pixel(10, 15).0, [0, 0, 255]);
+        assert_eq!(over.get_pixel(11, 15).0, [245; 3]);
+        // Placed one metre (20 cells) to the right: the wall is drawn there instead.
+        let moved = OverlayLayer { placement: crate::pose(1.0, 0.0, 0.0), ..layer };
+        let over = overlay(&g, &[moved]);
+        assert_eq!(over.get_pixel(10, 15).0, [150; 3]);
+        assert_eq!(over.get_pixel(30, 15).0, [0, 0, 255]);
     }
 
     fn yaml(text: &str) -> Result<MapYaml, MapIoError> {

@@ -63,6 +63,10 @@ pub struct RunOutput {
     pub truth: OccupancyGrid,
     /// Merge outcomes, in algorithm order (with merged maps when accepted).
     pub merges: Vec<MergeOutcome>,
+    /// Each robot's SLAM frame in the world (its true pose at its first processed scan), by robot name.
+    pub frames: BTreeMap<String, Pose2>,
+    /// Each robot's SLAM path (the best particle's pose at every processed scan, its own frame), by robot name.
+    pub paths: BTreeMap<String, Vec<Pose2>>,
 }
 
 /// Builds `algorithm`'s merger with the scenario's merge settings, its random draws seeded by the scenario's seed.
@@ -215,7 +219,7 @@ pub fn run(scenario: &Scenario, mut opts: RunOptions) -> Result<RunOutput, RunEr
         merges: results,
         observed_overlap: if either == 0 { 0.0 } else { both as f64 / either as f64 },
     };
-    Ok(RunOutput { report, maps: evaluated.maps, truth, merges })
+    Ok(RunOutput { report, maps: evaluated.maps, truth, merges, frames: evaluated.frames, paths: evaluated.paths })
 }
 
 /// Puts the scenario's robots into the simulator, each with its SLAM filter (seeded by the scenario's seed and
@@ -352,6 +356,8 @@ struct Evaluated {
     frames: BTreeMap<String, Pose2>,
     /// Each robot's SLAM frame placed so that its last SLAM pose is its true pose.
     end_frames: BTreeMap<String, Pose2>,
+    /// Each robot's SLAM path in its own frame.
+    paths: BTreeMap<String, Vec<Pose2>>,
 }
 
 /// Scores each robot's SLAM trajectory and map against the truth and takes its final map.
@@ -361,6 +367,7 @@ fn evaluate_robots(agents: &[Agent], truth: &OccupancyGrid, opts: &mut RunOption
         maps: BTreeMap::new(),
         frames: BTreeMap::new(),
         end_frames: BTreeMap::new(),
+        paths: BTreeMap::new(),
     };
     for (k, a) in agents.iter().enumerate() {
         let map = a.slam.map().map_err(|error| RunError::Slam { robot: a.setup.name.clone(), error })?;
@@ -403,6 +410,7 @@ fn evaluate_robots(agents: &[Agent], truth: &OccupancyGrid, opts: &mut RunOption
         out.end_frames.insert(a.setup.name.clone(), end_frame);
         out.frames.insert(a.setup.name.clone(), t0);
         out.maps.insert(a.setup.name.clone(), map);
+        out.paths.insert(a.setup.name.clone(), traj);
     }
     Ok(out)
 }
@@ -475,7 +483,30 @@ fn expected_end(scenario: &Scenario, sim: &Sim, agents: &[Agent], t: f64) -> f64
     }
 }
 
-/// Writes a run's maps (YAML+PGM, each with a PNG preview), the true map, merged maps and `report.json` (last)
+/// The picture of a merge: the true map in grey, the first robot's map (blue) at its true frame, the second's
+/// (orange) placed by the merge's estimate `t_a_b` from there, each with its SLAM path: where the estimate is
+/// right, both robots' walls lie on the truth's.
+pub fn merge_overlay(out: &RunOutput, t_a_b: &Pose2) -> image::RgbImage {
+    let [host, other] = &out.report.merge_pair;
+    let frame = out.frames.get(host).copied().unwrap_or_else(Pose2::identity);
+    let layer = |name: &String, placement: Pose2, colour: [u8; 3]| {
+        out.maps.get(name).map(|map| map_io::OverlayLayer {
+            map,
+            placement,
+            path: out.paths.get(name).map_or(&[][..], Vec::as_slice),
+            colour,
+        })
+    };
+    let layers: Vec<map_io::OverlayLayer> =
+        [layer(host, frame, [30, 90, 220]), layer(other, frame * t_a_b, [235, 120, 20])]
+            .into_iter()
+            .flatten()
+            .collect();
+    map_io::overlay(&out.truth, &layers)
+}
+
+/// Writes a run's maps (YAML+PGM, each with a PNG preview), the true map, merged maps with a picture of each
+/// accepted merge over the truth (`overlay_<algorithm>.png`, see [`merge_overlay`]) and `report.json` (last)
 /// into `dir`.
 pub fn write_outputs(out: &RunOutput, dir: &Path) -> Result<(), RunError> {
     std::fs::create_dir_all(dir).map_err(|cause| MapIoError::Io { path: dir.to_path_buf(), cause })?;
@@ -485,13 +516,20 @@ pub fn write_outputs(out: &RunOutput, dir: &Path) -> Result<(), RunError> {
     map_io::write_ros_map_with_preview(&out.truth, &dir.join("truth.yaml"))?;
     for m in &out.merges {
         let path = dir.join(format!("merged_{}.yaml", m.report.algorithm));
+        let picture = dir.join(format!("overlay_{}.png", m.report.algorithm));
         match &m.merged {
-            Some(g) => map_io::write_ros_map_with_preview(g, &path)?,
+            Some(g) => {
+                map_io::write_ros_map_with_preview(g, &path)?;
+                if let Some(t) = m.report.transform {
+                    map_io::write_rgb_png(&merge_overlay(out, &t.to_pose()), &picture)?;
+                }
+            }
             None => {
                 // A rejected merge leaves no map, not even a stale one from an earlier run.
                 let _ = std::fs::remove_file(&path);
                 let _ = std::fs::remove_file(path.with_extension("pgm"));
                 let _ = std::fs::remove_file(map_io::preview_path(&path));
+                let _ = std::fs::remove_file(&picture);
             }
         }
     }
