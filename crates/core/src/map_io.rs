@@ -622,17 +622,22 @@ pub fn preview_with_path(grid: &OccupancyGrid, path: &[Point2<f64>]) -> image::R
         (cx - x0 as f64, (full.height as f64 - cy) - y0 as f64)
     };
     for pair in path.windows(2) {
-        let (a, b) = (pixel(&pair[0]), pixel(&pair[1]));
-        let steps = ((b.0 - a.0).abs().max((b.1 - a.1).abs()).ceil() as usize).clamp(1, 100_000);
-        for k in 0..=steps {
-            let t = k as f64 / steps as f64;
-            let (x, y) = (a.0 + t * (b.0 - a.0), a.1 + t * (b.1 - a.1));
+        segment(pixel(&pair[0]), pixel(&pair[1]), |x, y| {
             if x >= 0.0 && y >= 0.0 && (x as usize) < w && (y as usize) < h {
                 out.put_pixel(x as u32, y as u32, image::Rgb([220, 30, 30]));
             }
-        }
+        });
     }
     out
+}
+
+/// Visits the points of the straight line from pixel `a` to pixel `b` (fractional), at most one pixel apart.
+fn segment(a: (f64, f64), b: (f64, f64), mut visit: impl FnMut(f64, f64)) {
+    let steps = ((b.0 - a.0).abs().max((b.1 - a.1).abs()).ceil() as usize).clamp(1, 100_000);
+    for k in 0..=steps {
+        let t = k as f64 / steps as f64;
+        visit(a.0 + t * (b.0 - a.0), a.1 + t * (b.1 - a.1));
+    }
 }
 
 /// One map laid over another in [`overlay`]: its occupied cells and a path, placed in the base map's frame.
@@ -689,11 +694,7 @@ pub fn overlay(base: &OccupancyGrid, layers: &[OverlayLayer]) -> image::RgbImage
         for pair in layer.path.windows(2) {
             let a = pixel(&(layer.placement * Point2::from(pair[0].translation.vector)));
             let b = pixel(&(layer.placement * Point2::from(pair[1].translation.vector)));
-            let steps = ((b.0 - a.0).abs().max((b.1 - a.1).abs()).ceil() as usize).clamp(1, 100_000);
-            for k in 0..=steps {
-                let t = k as f64 / steps as f64;
-                put(a.0 + t * (b.0 - a.0), a.1 + t * (b.1 - a.1), dark);
-            }
+            segment(a, b, |x, y| put(x, y, dark));
         }
     }
     out
