@@ -169,7 +169,8 @@ pub fn run(args: SlamArgs) -> Result<ExitCode> {
     // The preview beside the map: the map with the best particle's path (a pose per scan) in red.
     let path: Vec<nalgebra::Point2<f64>> = poses.iter().map(|p| p.translation.vector.into()).collect();
     let preview = map_io::preview_path(&args.output);
-    map_io::write_map_preview_with_path(&map, &path, &preview).with_context(|| format!("{}", preview.display()))?;
+    map_io::write_rgb_png(&map_io::preview_with_path(&map, &path), &preview)
+        .with_context(|| format!("{}", preview.display()))?;
     if let Some(path) = &args.trajectory {
         let header = format!(
             "mrslam slam {}: one pose per scan ({} scans), `stamp x y theta`, the best particle's robot pose in \

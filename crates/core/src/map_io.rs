@@ -708,15 +708,6 @@ pub fn write_rgb_png(img: &image::RgbImage, png_path: &Path) -> Result<(), MapIo
     write_file_atomic(png_path, &bytes)
 }
 
-/// Writes [`preview_with_path`] as a PNG at `png_path` (through a temporary name).
-pub fn write_map_preview_with_path(
-    grid: &OccupancyGrid,
-    path: &[Point2<f64>],
-    png_path: &Path,
-) -> Result<(), MapIoError> {
-    write_rgb_png(&preview_with_path(grid, path), png_path)
-}
-
 /// Writes [`preview_image`] of `grid` as a PNG at `png_path` (through a temporary name).
 pub fn write_map_preview(grid: &OccupancyGrid, png_path: &Path) -> Result<(), MapIoError> {
     write_file_atomic(png_path, &encode_png(&preview_image(grid), png_path)?)

@@ -15,7 +15,7 @@
 //! filter put the scan), so the filter must have kept the loop within that window: loop closure corrects a
 //! filter's residual drift, it does not replace the filter.
 
-use crate::params::{MatcherKind, SlamParams};
+use crate::params::SlamParams;
 use crate::particle::TrajectoryNode;
 use crate::pose_graph::{Edge, optimize};
 use crate::scan_matcher::{Beam, PreparedScan, ScanMatcher, Scratch};
@@ -118,22 +118,8 @@ pub fn close_loops(nodes: &[&TrajectoryNode], laser: Xyt, params: &SlamParams) -
 
 /// The field matcher the loop search uses: the filter's kernel and reach, no prior, every beam.
 fn loop_matcher(params: &SlamParams, laser: Xyt) -> ScanMatcher {
-    let p = SlamParams {
-        matcher: MatcherKind::Field,
-        lskip: 0,
-        seen_band: 0.0,
-        iterations: 2,
-        refine_iterations: 10,
-        heading_search: params.loop_heading_window,
-        heading_step: 0.01,
-        motion_prior: 0.0,
-        minimum_score: 0.0,
-        frontier_guard: false,
-        odometry_calibration: 0.0,
-        weight_all_beams: false,
-        kernel_likelihood: false,
-        ..params.clone()
-    };
+    let p =
+        SlamParams { heading_search: params.loop_heading_window, motion_prior: 0.0, ..params.field_matcher_alone() };
     ScanMatcher::from_params(&p, laser)
 }
 
@@ -182,14 +168,9 @@ fn match_loop(
     }
     let (climbed, _) = matcher.climb(&best.1, |q| matcher.field_eval(f, q, &scan.matched).score);
     let refined = matcher.refine(f, &climbed, &scan.matched, None);
-    let pose = if matcher.field_eval(f, &refined, &scan.matched).score
-        >= matcher.field_eval(f, &climbed, &scan.matched).score
-    {
-        refined
-    } else {
-        climbed
-    };
-    let e = matcher.field_eval(f, &pose, &scan.matched);
+    let (at_climbed, at_refined) =
+        (matcher.field_eval(f, &climbed, &scan.matched), matcher.field_eval(f, &refined, &scan.matched));
+    let (pose, e) = if at_refined.score >= at_climbed.score { (refined, at_refined) } else { (climbed, at_climbed) };
     if (e.matched as f64) < params.loop_min_matched * scan.matched.len() as f64 {
         return None;
     }

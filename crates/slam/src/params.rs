@@ -325,6 +325,26 @@ impl SlamParams {
         }
     }
 
+    /// These parameters with the `field` matcher set up to match one scan on its own: every beam, no seen band,
+    /// a short climb and Gauss-Newton, none of the filter's options (minimum score, frontier guard, calibration,
+    /// all-beam or kernel weighting). What the scan odometry and the loop closure start from.
+    pub(crate) fn field_matcher_alone(&self) -> Self {
+        SlamParams {
+            matcher: MatcherKind::Field,
+            lskip: 0,
+            seen_band: 0.0,
+            iterations: 2,
+            refine_iterations: 10,
+            heading_step: 0.01,
+            minimum_score: 0.0,
+            frontier_guard: false,
+            odometry_calibration: 0.0,
+            weight_all_beams: false,
+            kernel_likelihood: false,
+            ..self.clone()
+        }
+    }
+
     /// GMapping's defaults with the `field` matcher settings both robot presets share.
     fn field_matcher() -> Self {
         SlamParams {

@@ -20,7 +20,7 @@
 //! (along a featureless corridor) keeps the odometry's increment.
 
 use crate::motion::MotionModel;
-use crate::params::{MatcherKind, SlamParams};
+use crate::params::SlamParams;
 use crate::scan_matcher::{MotionPrior, PreparedScan, ScanMatcher, Scratch};
 use crate::tile_map::TileMap;
 use mrslam_core::{LaserScan, Pose2};
@@ -70,22 +70,11 @@ impl ScanOdometry {
     /// Scan-matched odometry with the `scan_odometry_*` settings of `params`, for a laser mounted at `laser`.
     pub fn new(params: &SlamParams, laser: Xyt) -> Self {
         let matcher_params = SlamParams {
-            matcher: MatcherKind::Field,
             sigma: params.scan_odometry_sigma,
-            lskip: 0,
-            seen_band: 0.0,
-            iterations: 2,
-            refine_iterations: 10,
             heading_search: params.scan_odometry_heading_search,
-            heading_step: 0.01,
             motion_prior: 1.0,
-            minimum_score: 0.0,
-            frontier_guard: false,
-            odometry_calibration: 0.0,
-            weight_all_beams: false,
-            kernel_likelihood: false,
             field_reach: params.scan_odometry_reach,
-            ..params.clone()
+            ..params.field_matcher_alone()
         };
         ScanOdometry {
             matcher: ScanMatcher::from_params(&matcher_params, laser),

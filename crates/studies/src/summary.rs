@@ -5,6 +5,7 @@
 //! bins [`SIM_BIN_WIDTH`] wide, named by their centre.
 
 use super::StudyError;
+use super::logs::median;
 use super::results::TrialRow;
 use super::wilson::{Z95, wilson_interval};
 use std::fmt::Write as _;
@@ -53,15 +54,6 @@ pub fn bin_of(r: &TrialRow) -> f64 {
             ((k + 0.5) * SIM_BIN_WIDTH * 1e9).round() / 1e9
         }
     }
-}
-
-fn median(v: &mut [f64]) -> f64 {
-    if v.is_empty() {
-        return f64::NAN;
-    }
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    if n % 2 == 1 { v[n / 2] } else { (v[n / 2 - 1] + v[n / 2]) / 2.0 }
 }
 
 /// Summarises rows: sorted by bin, then algorithm in order of first appearance.
