@@ -8,7 +8,7 @@ use std::path::PathBuf;
 /// Where to send a rerun recording (none of them: nothing is recorded).
 #[derive(Args, Debug, Default)]
 pub struct VizArgs {
-    /// Save a rerun recording here (.rrd; open it with `rerun FILE`). Reproducible: same input, same bytes.
+    /// Save a rerun recording here (.rrd; open it with `rerun FILE`). Reproducible: same input, same recorded content.
     #[arg(long, value_name = "FILE")]
     pub rrd: Option<PathBuf>,
     /// Start the rerun viewer (`rerun` on PATH; `pip install rerun-sdk==0.36.3`) and stream to it.

@@ -1,11 +1,12 @@
 //! `mrslam run ... --rrd` and `mrslam merge ... --rrd`, as a user would: the recording is read back with rerun's
 //! own decoder (through `mrslam_viz::inspect`), and must hold the designed entity paths and timelines with
-//! plausible counts, identical bytes on a second run, and bad destinations must fail before any work.
+//! plausible counts, an RRD footer with a manifest per store, the same content on a second run; bad destinations
+//! must fail before any work, and an interrupted run must leave nothing under the recording's name.
 
 use crate::util::{mrslam, p, text};
 use mrslam_core::map_io::write_ros_map;
 use mrslam_merge::floorplan::{FloorplanParams, generate};
-use mrslam_viz::inspect::summarize;
+use mrslam_viz::inspect::{first_difference, summarize};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -91,12 +92,60 @@ fn run_records_the_designed_entities_and_timelines_reproducibly() {
     assert_eq!(s.rows_at("/merge/sift/matches"), 1);
     assert!(s.rows_at("/events") >= 2, "run start and the merge verdict: {:?}", s.rows);
 
-    // Reproducible: a second run of the same scenario writes the same bytes.
+    // A standard recording: the footer has a manifest for the recording and for its blueprint.
+    let stores: Vec<&str> = s.recordings.iter().chain(&s.blueprints).map(String::as_str).collect();
+    assert_eq!(s.footer_manifests.iter().map(String::as_str).collect::<Vec<_>>(), sorted(&stores), "{s:?}");
+
+    // Reproducible: a second run of the same scenario records the same messages (the footer's bytes may differ).
     let again = d.join("again.rrd");
     let o = run_with_rrd(&scenario, &d.join("out2"), &again);
     assert!(o.status.success(), "{}", text(&o.stderr));
-    let (x, y) = (std::fs::read(&rrd).unwrap(), std::fs::read(&again).unwrap());
-    assert!(x == y, "two runs of one scenario differ ({} and {} bytes)", x.len(), y.len());
+    assert_eq!(first_difference(&rrd, &again).unwrap(), None, "two runs of one scenario differ");
+    // And the comparison sees a difference where there is one: another seed.
+    let other = d.join("other.rrd");
+    let o = mrslam(&["run", p(&scenario), "--quiet", "--out", p(&d.join("out3")), "--rrd", p(&other), "--seed", "12"]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let diff = first_difference(&rrd, &other).unwrap().expect("two seeds must not record the same run");
+    assert!(diff.contains("message"), "{diff}");
+}
+
+fn sorted<'a>(xs: &[&'a str]) -> Vec<&'a str> {
+    let mut v = xs.to_vec();
+    v.sort_unstable();
+    v
+}
+
+#[cfg(unix)]
+#[test]
+fn a_run_interrupted_by_sigint_leaves_no_recording_under_its_name() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let scenario = short_scenario(d, 170.0);
+    let rrd = d.join("run.rrd");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_mrslam"))
+        .args(["run", p(&scenario), "--quiet", "--out", p(&d.join("out")), "--rrd", p(&rrd)])
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    // Interrupt once the recording has started (its partial file holds data), as a user's Ctrl-C would.
+    let partial = mrslam_viz::partial_path(&rrd);
+    let start = std::time::Instant::now();
+    while partial.metadata().map_or(0, |m| m.len()) < 4096 && start.elapsed().as_secs() < 60 {
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+    std::thread::sleep(std::time::Duration::from_millis(500));
+    let killed = Command::new("kill").args(["-INT", &child.id().to_string()]).status().unwrap();
+    assert!(killed.success());
+    let status = child.wait().unwrap();
+    assert!(!status.success(), "the run finished before the interrupt: make the scenario longer");
+    assert!(!rrd.exists(), "an interrupted run left a recording under the final name");
+    assert!(partial.metadata().unwrap().len() > 0, "what was recorded is kept under the partial name");
+    assert!(!d.join("out/report.json").exists(), "an interrupted run left a report");
+    // What is kept is readable up to where the run stopped, and is not mistaken for a finished recording:
+    // it has no footer.
+    let s = summarize(&partial).unwrap();
+    assert!(s.rows_at("/world/walls") == 1 && s.footer_manifests.is_empty(), "{s:?}");
 }
 
 #[test]
@@ -215,6 +264,7 @@ fn merge_records_both_maps_keypoints_matches_and_the_merged_map() {
     assert_eq!(s.rows_at("/merge/sift/merged"), 1, "the pair merges, so the merged map is there");
     assert!(s.rows_at("/events") >= 1);
     assert_eq!(s.activations, 1);
+    assert_eq!(s.footer_manifests.len(), 2, "a manifest for the recording and one for its blueprint: {s:?}");
 
     // An unwritable --rrd fails before the merge, with the path named.
     let bad = d.join("missing/merge.rrd");

@@ -5,7 +5,9 @@
 //! therefore builds the chunks itself: row and chunk ids come from counters, the only timelines are `sim_time`
 //! and `step`, and rows are grouped into chunks per entity every [`Recorder::FLUSH_PERIOD_S`] of simulated
 //! time (or sooner when a lot is pending). The chunks go straight to rerun's sinks (file or gRPC), which encode
-//! them unchanged: same scenario, same seed, same build ⇒ the same bytes.
+//! them unchanged: same scenario, same seed, same build ⇒ the same messages (the `.rrd` footer that the file sink
+//! adds at the end lists them per store in hash-map order, so the bytes may differ there; see
+//! [`crate::inspect::first_difference`]).
 
 use crate::error::VizError;
 use crate::target::Target;

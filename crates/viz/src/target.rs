@@ -143,11 +143,11 @@ fn open_file(path: &Path, partial: &Path) -> Result<Box<dyn LogSink>, VizError> 
     {
         return Err(err(format!("folder {} does not exist", dir.display())));
     }
-    // FileSink creates the file now, so a path that cannot be written fails here, before any work is done.
-    // No RRD footer: its per-store manifests come out in hash-map order (the recording and its blueprint are two
-    // stores), which would make two runs' files differ; the footer only speeds up random access to big files,
-    // and `rerun rrd optimize` can add one.
-    let options = FileSinkOptions { write_footer: false };
+    // FileSink creates the file now, so a path that cannot be written fails here, before any work is done. The
+    // footer (one manifest per store, for random access and for `rerun rrd verify`) is written when the sink is
+    // dropped; its manifests come out in hash-map order, so two runs' files hold the same messages but not always
+    // the same bytes (`inspect::first_difference` compares the content).
+    let options = FileSinkOptions::default();
     let sink = FileSink::with_options(partial, options).map_err(|e| match e {
         rerun::sink::FileSinkError::CreateFile { source, .. } => err(source.to_string()),
         other => err(other.to_string()),
