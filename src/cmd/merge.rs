@@ -7,8 +7,8 @@ use mrslam_core::OccupancyGrid;
 use mrslam_core::map_io::{self, write_file_atomic};
 use mrslam_merge::MapImage;
 use mrslam_merge::{
-    Algorithm, CorrelativeMerger, Evidence, FusionRule, MapEncoding, MatchParams, MergeParams, MergeReport, Merger,
-    Model, RmapMerger, RmapParams, SiftMerger, SiftMergerParams, merge,
+    Algorithm, CorrelativeMerger, CorrelativeParams, Evidence, FusionRule, MapEncoding, MatchParams, MergeParams,
+    MergeReport, Merger, Model, RmapMerger, RmapParams, SiftMerger, SiftMergerParams, merge,
 };
 use mrslam_testbed::runner::merge_view;
 use mrslam_viz::pair::record_pair;
@@ -58,6 +58,11 @@ pub struct MergeArgs {
     /// (1: the 3x3 neighbourhood, the gate before 2026-12-02; 2 lets the walls of two robots' SLAM runs meet).
     #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u32).range(0..=4))]
     pub wall_tolerance: u32,
+    /// The correlative merger's significance test: its best pose must score this share above every pose clearly
+    /// apart from it (Lowe's ratio test), else the merge is refused as ambiguous, naming the rival; 0 turns the
+    /// test off [default: `CorrelativeParams::default().min_margin`, 0.15].
+    #[arg(long, value_parser = margin)]
+    pub min_margin: Option<f64>,
     /// Map-to-image encoding: `walls` (free and unknown alike) or `paper` (unknown grey).
     #[arg(long, default_value = "walls", value_parser = ["walls", "paper"])]
     pub encoding: String,
@@ -83,6 +88,15 @@ fn ratio(s: &str) -> Result<f32, String> {
     match s.parse::<f32>() {
         Ok(r) if r > 0.0 && r <= 1.0 => Ok(r),
         Ok(r) => Err(format!("{r} is outside (0, 1]")),
+        Err(e) => Err(e.to_string()),
+    }
+}
+
+/// Reads `--min-margin`: a number in [0, 1).
+fn margin(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(m) if (0.0..1.0).contains(&m) => Ok(m),
+        Ok(m) => Err(format!("{m} is outside [0, 1)")),
         Err(e) => Err(e.to_string()),
     }
 }
@@ -137,7 +151,11 @@ pub fn run(args: MergeArgs) -> Result<ExitCode> {
             rp.orient.seed = args.seed;
             Box::new(RmapMerger::new(rp))
         }
-        Algorithm::Correlative => Box::new(CorrelativeMerger::default()),
+        Algorithm::Correlative => {
+            let mut cp = CorrelativeParams::default();
+            cp.min_margin = args.min_margin.unwrap_or(cp.min_margin);
+            Box::new(CorrelativeMerger::new(cp))
+        }
     };
     let mut mp = MergeParams { verify_enabled: !args.no_verify, fusion: args.fusion, ..MergeParams::default() };
     mp.verify.wall_tolerance_cells = args.wall_tolerance as usize;

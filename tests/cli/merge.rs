@@ -165,3 +165,38 @@ fn rmap_algorithm_writes_the_same_report() {
         }
     }
 }
+
+/// An 8 m x 6 m building at 5 cm that a half turn about its centre maps onto itself.
+fn symmetric_building() -> mrslam_core::OccupancyGrid {
+    let (w, h) = (160usize, 120usize);
+    let mut g = mrslam_core::OccupancyGrid::new(w, h, 0.05, mrslam_core::pose(0.0, 0.0, 0.0)).unwrap();
+    for iy in 0..h {
+        for ix in 0..w {
+            let border = ix < 2 || iy < 2 || ix >= w - 2 || iy >= h - 2;
+            let inner = ((39..41).contains(&iy) && ix < 60) || ((79..81).contains(&iy) && ix >= 100);
+            g.set(ix, iy, if border || inner { 2.0 } else { -2.0 });
+        }
+    }
+    g
+}
+
+#[test]
+fn correlative_refuses_an_ambiguous_pose_naming_the_rival_unless_the_test_is_off() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let (a, report) = (d.join("a.yaml"), d.join("r.json"));
+    write_ros_map(&symmetric_building(), &a).unwrap();
+    let run = |extra: &[&str]| {
+        let mut args = vec!["merge", p(&a), p(&a), "--algorithm", "correlative", "--report", p(&report)];
+        args.extend_from_slice(extra);
+        let o = mrslam(&args);
+        let r: serde_json::Value = serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();
+        (o, r)
+    };
+    let (o, r) = run(&[]);
+    assert_eq!(o.status.code(), Some(2), "{}{}", text(&o.stdout), text(&o.stderr));
+    let reason = r["reason"].as_str().unwrap();
+    assert!(reason.starts_with("ambiguous") && reason.contains("deg and"), "{reason}");
+    let (_, r) = run(&["--min-margin", "0"]);
+    assert!(!r["reason"].as_str().unwrap_or("").starts_with("ambiguous"), "{r}");
+}

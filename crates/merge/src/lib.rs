@@ -62,6 +62,7 @@ pub use verify::{Agreement, VerifyParams, agreement, agreement_within};
 /// repository): the R-map's maximal empty rectangles, wall ICP, wall hits, descriptor matching. Not part of
 /// the crate's API.
 pub mod dev {
+    pub use crate::correlative::{Significance, score_near, significance};
     pub use crate::matching::{Match, match_features};
     pub use crate::refine::{refine, wall_points};
     pub use crate::rmap::{FreeMatrix, Mer, mers};

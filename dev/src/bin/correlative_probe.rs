@@ -31,6 +31,10 @@ fn set(p: &mut CorrelativeParams, kv: &str) {
         "acc" => p.min_acceptance = f,
         "area" => p.min_overlap_m2 = f,
         "par" => p.parallel = f != 0.0,
+        "margin" => p.min_margin = f,
+        "clear" => p.free_clearance_m = f,
+        "rdist" => p.rival_distinct_m = f,
+        "rivals" => p.rivals = f as usize,
         _ => panic!("unknown key {k}"),
     }
 }
@@ -159,7 +163,11 @@ fn main() {
         // Gap pairs (nothing shared) and low-overlap pairs of generated plans: what separates a coincidence
         // from a true answer? Prints one line per pair: kind, size, seed, accepted (tolerance 1 / 2), error,
         // the best answer's matched walls and the runner-up's.
-        let cor = CorrelativeMerger::new(p);
+        for kv in &args[1..] {
+            set(&mut p, kv);
+        }
+        // The significance test off throughout: its margin is printed, each threshold judged afterwards.
+        let cor = CorrelativeMerger::new(CorrelativeParams { min_margin: 0.0, ..p });
         for (w, h) in [(18.0, 14.0), (24.0, 18.0)] {
             for seed in 0..60u64 {
                 let map =
@@ -170,18 +178,16 @@ fn main() {
                         println!("{overlap} {w}x{h} {seed} none");
                         continue;
                     };
-                    let mut acc = Vec::new();
-                    for tol in [1usize, 2] {
-                        let mut mp = MergeParams::default();
-                        mp.verify.wall_tolerance_cells = tol;
-                        acc.push(merge(&cor, &pair.a, &pair.b, &mp).report.accepted);
-                    }
+                    let out = merge(&cor, &pair.a, &pair.b, &MergeParams::default());
+                    let acc = out.report.accepted;
+                    let out_err = out.report.transform.map(|t| error(&pose(t.x, t.y, t.theta), &pair.t_a_b));
                     let (d, deg) = error(&al.transform, &pair.t_a_b);
+                    let margin =
+                        mrslam_merge::dev::significance(&cor, &pair.a, &pair.b).map_or(f64::NAN, |s| s.margin());
                     let second = al.alternatives.first().map_or(0, |h| h.inliers);
                     let agr = mrslam_merge::agreement_within(&pair.a, &pair.b, &al.transform, 2);
                     println!(
-                        "{overlap} {w}x{h} {seed} acc {:?} err {d:.3} {deg:.2} inl {} second {second} matches {} common {} walls2 {:.3} omega {:.3}",
-                        acc,
+                        "{overlap} {w}x{h} {seed} acc {acc} merr {out_err:?} err {d:.3} {deg:.2} margin {margin:.3} inl {} second {second} matches {} common {} walls2 {:.3} omega {:.3}",
                         al.inliers,
                         al.matches,
                         agr.common(),
@@ -224,5 +230,25 @@ fn main() {
             );
         }
     }
-    run(&CorrelativeMerger::new(p), &a, &b, truth.as_ref());
+    let cor = CorrelativeMerger::new(p);
+    if let Some(sig) = mrslam_merge::dev::significance(&cor, &a, &b) {
+        let (s, c, _) = mrslam_merge::dev::score_near(&cor, &a, &b, &sig.best);
+        println!(
+            "global best {:?} score {} (wall/free/other points {c:?}, rescored {s}), rival {:?} score {}, margin {:.3}",
+            xyt(&sig.best),
+            sig.best_score,
+            sig.rival.as_ref().map(xyt),
+            sig.rival_score,
+            sig.margin()
+        );
+        if let Some(t) = &truth {
+            let (s, c, at) = mrslam_merge::dev::score_near(&cor, &a, &b, t);
+            println!("global score near the truth {s} at {:?} (wall/free/other points {c:?})", xyt(&at));
+        }
+    }
+    run(&cor, &a, &b, truth.as_ref());
+}
+
+fn xyt(t: &Pose2) -> (f64, f64, f64) {
+    (t.translation.x, t.translation.y, t.rotation.angle().to_degrees())
 }
