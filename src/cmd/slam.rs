@@ -12,7 +12,9 @@ use mrslam_core::map_io::{self, write_file_atomic};
 use mrslam_core::relations::{self, StampedPose};
 use mrslam_core::{Odometry, Pose2};
 use mrslam_slam::synthetic::{Drift, inject_drift};
-use mrslam_slam::{LogRunError, Preset, Rbpf, map_log};
+use mrslam_slam::{LogRun, LogRunError, Preset, Rbpf, map_log};
+use mrslam_viz::{Level, ProcessedScan, RelationMark, SlamLogRecorder};
+use nalgebra::Point2;
 use serde_json::json;
 use std::io::IsTerminal;
 use std::path::PathBuf;
@@ -78,11 +80,18 @@ pub struct SlamArgs {
     /// Hide the progress bar.
     #[arg(long)]
     pub quiet: bool,
+    /// Where to watch the run (rerun): the map as it grows, the best particle's path and the odometry's, the
+    /// particles, the scan, Neff, the real-time factor, resampling and loop closure, the relations' errors.
+    #[command(flatten)]
+    pub viz: super::viz::VizArgs,
 }
 
 /// Runs `mrslam slam`.
 pub fn run(args: SlamArgs) -> Result<ExitCode> {
-    let outputs = [Some(&args.output), args.trajectory.as_ref(), args.summary.as_ref()];
+    if let Some(p) = &args.viz.rrd {
+        super::paths::check_extension(p, "--rrd", &["rrd"])?;
+    }
+    let outputs = [Some(&args.output), args.trajectory.as_ref(), args.summary.as_ref(), args.viz.rrd.as_ref()];
     let inputs: Vec<&std::path::Path> = std::iter::once(args.log.as_path()).chain(args.relations.as_deref()).collect();
     for p in outputs.into_iter().flatten() {
         super::check_output(p)?;
@@ -135,6 +144,14 @@ pub fn run(args: SlamArgs) -> Result<ExitCode> {
 
     let offset: Pose2 = log.scans[0].laser_offset;
     let mut filter = Rbpf::new(params, offset, args.seed).context("slam parameters")?;
+    // The recording's destinations are opened before the long work, so that a bad one fails at once.
+    let name = args.log.file_name().map_or_else(|| "log".to_string(), |n| n.to_string_lossy().into_owned());
+    let name = name.trim_end_matches(".gz").trim_end_matches(".clf").trim_end_matches(".log").to_string();
+    let mut viz = args
+        .viz
+        .open(&format!("slam-{name}-{}-seed{}", args.preset, args.seed), &format!("slam {name}"))?
+        .map(|rec| SlamLogRecorder::new(rec, &name));
+    let stamp0 = log.scans[0].scan.stamp;
     let bar = ProgressBar::new(log.scans.len() as u64);
     if args.quiet || !std::io::stderr().is_terminal() {
         bar.set_draw_target(ProgressDrawTarget::hidden());
@@ -144,11 +161,40 @@ pub fn run(args: SlamArgs) -> Result<ExitCode> {
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
     let start = std::time::Instant::now();
-    let run = map_log(&mut filter, odo.iter().zip(log.scans.iter().map(|r| &r.scan)), |out| {
+    let mut index = 0;
+    let mut first_slam = None;
+    let run = map_log(&mut filter, odo.iter().zip(log.scans.iter().map(|r| &r.scan)), |out, filter| {
         if let Some(neff) = out.neff() {
             bar.set_message(format!("Neff {neff:.1}"));
         }
         bar.inc(1);
+        if let Some(v) = viz.as_mut() {
+            let scan = &log.scans[index].scan;
+            let elapsed = start.elapsed().as_secs_f64();
+            v.set_time(index as u64, scan.stamp - stamp0);
+            if out.is_processed() {
+                let best = filter.best_pose();
+                first_slam.get_or_insert(best);
+                let points: Vec<Point2<f64>> = scan.endpoints(&(best * offset)).map(|(_, p)| p).collect();
+                v.processed(ProcessedScan {
+                    best: &best,
+                    points: &points,
+                    particles: filter.particles(),
+                    neff: filter.neff(),
+                    resampled: out.resampled(),
+                    realtime_factor: (elapsed > 0.0).then(|| (scan.stamp - stamp0) / elapsed),
+                });
+            }
+            if let Some(odom) = filter.odometry_pose() {
+                v.odometry(&odom, first_slam.as_ref());
+            }
+            if v.map_due()
+                && let Some(map) = filter.live_map()
+            {
+                v.map(&map);
+            }
+        }
+        index += 1;
     })
     .map_err(|e| match e {
         LogRunError::Reading { index, error } => {
@@ -160,12 +206,17 @@ pub fn run(args: SlamArgs) -> Result<ExitCode> {
     let secs = start.elapsed().as_secs_f64();
     let map = filter.map().context("building the map")?;
     map_io::write_ros_map(&map, &args.output).with_context(|| format!("{}", args.output.display()))?;
+    let score = rels.as_ref().map(|r| relations::score(&trajectory_of(&log.scans, &run.poses), r, args.tolerance));
+    if let Some(mut v) = viz.take() {
+        record_the_end(&mut v, &filter, &map, &run, &log.scans, score.as_ref())?;
+        let stats = v.finish()?;
+        println!("rerun: {} ({} rows in {} chunks)", args.viz.describe(), stats.rows, stats.chunks);
+    }
 
     // A pose for every scan: the filter's at the processed ones, odometry in between.
     let (poses, processed, loops) = (run.poses, run.processed, run.loop_closure);
     let stamps: Vec<f64> = log.scans.iter().map(|r| r.scan.stamp).collect();
-    let trajectory: Vec<StampedPose> =
-        stamps.iter().zip(&poses).map(|(&stamp, &pose)| StampedPose { stamp, pose }).collect();
+    let trajectory = trajectory_of(&log.scans, &poses);
     // The preview beside the map: the map with the best particle's path (a pose per scan) in red.
     let path: Vec<nalgebra::Point2<f64>> = poses.iter().map(|p| p.translation.vector.into()).collect();
     let preview = map_io::preview_path(&args.output);
@@ -189,7 +240,6 @@ pub fn run(args: SlamArgs) -> Result<ExitCode> {
         );
         write_file_atomic(path, relations::format_trajectory(&header, &trajectory).as_bytes())?;
     }
-    let score = rels.as_ref().map(|r| relations::score(&trajectory, r, args.tolerance));
 
     let c = filter.counters();
     let (free, occ, unknown) = map.state_counts();
@@ -297,6 +347,57 @@ pub fn run(args: SlamArgs) -> Result<ExitCode> {
         super::eval::write_json(path, &summary)?;
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// A pose for every scan: the scans' stamps with `poses`.
+fn trajectory_of(scans: &[mrslam_core::ScanRecord], poses: &[Pose2]) -> Vec<StampedPose> {
+    scans.iter().zip(poses).map(|(r, &pose)| StampedPose { stamp: r.scan.stamp, pose }).collect()
+}
+
+/// Records the end of the run: the loop closure, the final paths (smoothed), the output map, the relations.
+fn record_the_end(
+    v: &mut SlamLogRecorder,
+    filter: &Rbpf,
+    map: &mrslam_core::OccupancyGrid,
+    run: &LogRun,
+    scans: &[mrslam_core::ScanRecord],
+    score: Option<&relations::RelationsScore>,
+) -> Result<()> {
+    let stamp0 = scans[0].scan.stamp;
+    let last = scans.len() - 1;
+    v.set_time(last as u64, scans[last].scan.stamp - stamp0);
+    if let Some(l) = &run.loop_closure {
+        let level = if l.closures > 0 { Level::Info } else { Level::Warn };
+        let text = format!(
+            "loop closure: {} scans matched a place passed a loop ago, {} loop edges; a scan moved by at most {:.2} m",
+            l.candidates, l.closures, l.max_correction
+        );
+        v.event(level, &text);
+    }
+    let smoothed: Vec<Pose2> = filter.trajectory().into_iter().map(|(_, p)| p).collect();
+    v.paths(Some(&smoothed));
+    v.map(map);
+    if let Some(score) = score {
+        let stamps: Vec<f64> = scans.iter().map(|r| r.scan.stamp).collect();
+        let marks: Vec<RelationMark> = score
+            .errors
+            .iter()
+            .map(|e| {
+                // The scan nearest the relation's second stamp (the one the metric used, within its tolerance).
+                let i = stamps.partition_point(|&s| s < e.t2).min(last);
+                let i = if i > 0 && (stamps[i - 1] - e.t2).abs() < (stamps[i] - e.t2).abs() { i - 1 } else { i };
+                RelationMark {
+                    index: i as u64,
+                    time: stamps[i] - stamp0,
+                    at: run.poses[i],
+                    translation: e.translation,
+                    rotation: e.rotation,
+                }
+            })
+            .collect();
+        v.relations(&marks);
+    }
+    Ok(())
 }
 
 /// Odometry faster than this between two scans is a jump (a kidnapped robot or a reset), m/s.

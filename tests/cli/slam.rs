@@ -334,3 +334,78 @@ fn a_robotlaser1_log_maps_end_to_end() {
     // Odometry drifts 3 % of 1 m and 0.01 rad per metre on these relations: SLAM must be well under that.
     assert!(m["translation_mean_m"].as_f64().unwrap() < 0.03 && m["rotation_mean_deg"].as_f64().unwrap() < 1.0, "{m}");
 }
+
+#[test]
+fn a_recorded_run_holds_the_filter_as_it_went_and_the_relations_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let run = office_run();
+    let log = write_log(d, "office.clf", &carmen_lines(&run));
+    let rel = d.join("office.relations");
+    std::fs::write(&rel, true_relations(&run, 10)).unwrap();
+    let (map, summary, rrd) = (d.join("office.yaml"), d.join("office.json"), d.join("office.rrd"));
+    let p = |p: &Path| p.to_str().unwrap().to_string();
+    let o = mrslam(&[
+        "slam",
+        &p(&log),
+        "-o",
+        &p(&map),
+        "--relations",
+        &p(&rel),
+        "--summary",
+        &p(&summary),
+        "--rrd",
+        &p(&rrd),
+        "--quiet",
+    ]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    assert!(text(&o.stdout).contains("rerun: file"), "{}", text(&o.stdout));
+    let s: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&summary).unwrap()).unwrap();
+    let (processed, resamples) = (s["processed"].as_u64().unwrap() as usize, s["resamples"].as_u64().unwrap() as usize);
+    assert!(processed > 10, "{s}");
+
+    let r = mrslam_viz::inspect::summarize(&rrd).unwrap();
+    assert_eq!(r.recordings, ["slam-office-matched-seed0"]);
+    assert_eq!(r.footer_manifests.len(), 2, "a standard recording, footer and all: {r:?}");
+    assert_eq!(r.timelines.iter().map(String::as_str).collect::<Vec<_>>(), ["sim_time", "step"]);
+    // Rows logged over time (a series' static style left out).
+    let rows = |e: &str| r.rows_at(e) - r.static_rows.get(e).copied().unwrap_or(0);
+    // Every processed scan: the best pose, all particles, the scan, Neff and the real-time factor.
+    for e in [
+        "/robots/office/slam/pose",
+        "/robots/office/slam/particles",
+        "/robots/office/scan",
+        "/metrics/neff/office",
+        "/metrics/realtime/office",
+    ] {
+        assert_eq!(rows(e), processed, "{e}: {:?}", r.rows);
+    }
+    // Every reading's odometry (the filter has one from the first reading on).
+    assert_eq!(rows("/robots/office/odom/pose"), 240, "{:?}", r.rows);
+    // Throttled: paths at most every 2 s of the 24 s log, maps every 10 s, each plus the final one.
+    let log_s = 23.9;
+    for leaf in ["slam/path", "odom/path"] {
+        let n = rows(&format!("/robots/office/{leaf}")) as f64;
+        assert!(n >= 3.0 && n <= log_s / 2.0 + 2.0, "{leaf}: {n} rows");
+    }
+    let maps = rows("/maps/office") as f64;
+    assert!((3.0..=log_s / 10.0 + 2.0).contains(&maps), "{maps} maps");
+    // The relations: one value per relation scored, and their marks on the path.
+    assert_eq!(rows("/metrics/relations/office/translation"), 230);
+    assert_eq!(rows("/metrics/relations/office/rotation"), 230);
+    assert_eq!(rows("/robots/office/relations"), 1);
+    // Events: each resampling, and the loop closure's verdict (the matched preset closes loops).
+    assert_eq!(rows("/events"), resamples + 1, "{:?}", r.rows);
+    assert!(r.blueprint_entities.contains("/viewport"), "{:?}", r.blueprint_entities);
+
+    // A destination that cannot be written fails before the filter runs, and leaves no map.
+    let bad = d.join("missing/run.rrd");
+    let map2 = d.join("again.yaml");
+    let o = mrslam(&["slam", &p(&log), "-o", &p(&map2), "--rrd", &p(&bad), "--quiet"]);
+    assert_eq!(o.status.code(), Some(1), "{}", text(&o.stderr));
+    assert!(text(&o.stderr).contains(&p(&bad)) && text(&o.stderr).contains("does not exist"), "{}", text(&o.stderr));
+    assert!(!map2.exists(), "the run went ahead");
+    let o = mrslam(&["slam", &p(&log), "-o", &p(&map2), "--rrd", &p(&d.join("run.txt")), "--quiet"]);
+    assert_eq!(o.status.code(), Some(1), "{}", text(&o.stderr));
+    assert!(text(&o.stderr).contains("--rrd"), "{}", text(&o.stderr));
+}

@@ -41,12 +41,13 @@ pub enum LogRunError {
 
 /// Feeds `filter` a log's readings (each scan with its odometry, in order) and places every scan: the filter's
 /// pose at the processed ones, its odometry (scan-matched when `scan_odometry` is on) in between.
-/// `on_reading` sees each reading's outcome (for progress); with `loop_closure` on, the trajectory is then
-/// smoothed ([`Rbpf::close_loops`]). The map is the filter's afterwards.
+/// `on_reading` sees each reading's outcome and the filter after it (for progress, or to watch the filter);
+/// with `loop_closure` on, the trajectory is then smoothed ([`Rbpf::close_loops`]). The map is the filter's
+/// afterwards.
 pub fn map_log<'a>(
     filter: &mut Rbpf,
     readings: impl IntoIterator<Item = (&'a Odometry, &'a LaserScan)>,
-    mut on_reading: impl FnMut(&UpdateOutcome),
+    mut on_reading: impl FnMut(&UpdateOutcome, &Rbpf),
 ) -> Result<LogRun, LogRunError> {
     let mut processed = Vec::new();
     let mut odometry = Vec::new();
@@ -58,7 +59,7 @@ pub fn map_log<'a>(
         if out.is_processed() {
             processed.push(index);
         }
-        on_reading(&out);
+        on_reading(&out, filter);
     }
     let loop_closure = filter.params().loop_closure.then(|| filter.close_loops());
     let keyframes = filter.trajectory();

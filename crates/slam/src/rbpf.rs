@@ -580,6 +580,12 @@ impl Rbpf {
         self.particles.iter().map(|p| p.weight_sum).collect()
     }
 
+    /// The best particle's own map as its scan matcher sees it ([`crate::dev::TileMap::to_grid`]): cheap, for
+    /// watching the map grow; `None` while empty. [`Rbpf::map`] builds the output map.
+    pub fn live_map(&self) -> Option<OccupancyGrid> {
+        self.particles[self.best_index()].map.to_grid()
+    }
+
     /// The best particle's map as a log-odds grid (occupied +2, free −2, unknown 0; see `map_build`).
     ///
     /// Rebuilt from the best particle's trajectory on every call (like GMapping's ROS node does every

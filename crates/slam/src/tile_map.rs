@@ -254,6 +254,37 @@ impl TileMap {
         })
     }
 
+    /// The map as an occupancy grid, for watching it grow: cells with hits occupied, cells only crossed by a beam's
+    /// end band free, the rest unknown (free space is not traced per particle; [`crate::Rbpf::map`] builds the
+    /// output map). `None` while the map is empty or when it exceeds core's cell limit.
+    pub fn to_grid(&self) -> Option<mrslam_core::OccupancyGrid> {
+        let [x0, y0, x1, y1] = self.cell_bounds()?;
+        let (w, h) = ((x1 - x0 + 1) as usize, (y1 - y0 + 1) as usize);
+        let origin = mrslam_core::pose(x0 as f64 * self.delta, y0 as f64 * self.delta, 0.0);
+        let mut grid = mrslam_core::OccupancyGrid::new(w, h, self.delta, origin).ok()?;
+        for (slot, tile) in self.tiles.iter().enumerate() {
+            let Some(tile) = tile else { continue };
+            let (tx, ty) = (slot as i32 % self.tw, slot as i32 / self.tw);
+            for ly in 0..TILE {
+                let (seen, occupied) = (tile.seen[ly as usize], tile.occupied[ly as usize]);
+                if seen | occupied == 0 {
+                    continue;
+                }
+                for lx in 0..TILE {
+                    let l = if occupied >> lx & 1 != 0 {
+                        mrslam_core::map_io::ROS_LOGODDS_LIMIT
+                    } else if seen >> lx & 1 != 0 {
+                        -mrslam_core::map_io::ROS_LOGODDS_LIMIT
+                    } else {
+                        continue;
+                    };
+                    grid.set((tx * TILE + lx) as usize, (ty * TILE + ly) as usize, l);
+                }
+            }
+        }
+        Some(grid)
+    }
+
     /// Number of tile slots (allocated or not).
     pub fn tile_slots(&self) -> usize {
         self.tiles.len()
@@ -295,6 +326,25 @@ mod tests {
         m.add_hit(50.0, -40.0).unwrap();
         assert_eq!(m.hits(ix, iy), 2, "growth keeps old cells");
         assert_eq!(m.allocated_tiles(), 2);
+    }
+
+    #[test]
+    fn the_grid_puts_hits_and_seen_cells_where_the_tiles_have_them() {
+        use mrslam_core::CellState;
+        let mut m = TileMap::new(0.05);
+        assert!(m.to_grid().is_none(), "an empty map has no grid");
+        m.mark_seen(-1.0, 0.52, -0.5, 0.52).unwrap();
+        m.add_hit(-1.012, 2.031).unwrap();
+        let g = m.to_grid().unwrap();
+        let state = |x: f64, y: f64| {
+            let (ix, iy) = g.world_to_cell(&nalgebra::Point2::new(x, y)).unwrap();
+            g.state(ix, iy)
+        };
+        assert_eq!(state(-1.012, 2.031), CellState::Occupied);
+        assert_eq!(state(-0.75, 0.52), CellState::Free);
+        assert_eq!(state(-0.75, 1.5), CellState::Unknown);
+        let occupied = (0..g.height()).flat_map(|y| (0..g.width()).map(move |x| (x, y)));
+        assert_eq!(occupied.filter(|&(x, y)| g.state(x, y) == CellState::Occupied).count(), 1);
     }
 
     #[test]

@@ -96,7 +96,7 @@ pub fn map_part(
     let mut filter = Rbpf::new(params.clone(), first.laser_offset, seed)
         .map_err(|e| StudyError::Invalid(format!("slam parameters: {e}")))?;
     let run =
-        map_log(&mut filter, scans.iter().map(|r| (&r.odometry, &r.scan)), |_| on_scan()).map_err(|e| match e {
+        map_log(&mut filter, scans.iter().map(|r| (&r.odometry, &r.scan)), |_, _| on_scan()).map_err(|e| match e {
             LogRunError::Reading { index, error } => {
                 StudyError::file(log, format!("line {}: {error}", scans[index].line))
             }

@@ -70,6 +70,7 @@ pub struct Recorder {
     ids: Ids,
     time: TimePoint,
     sim_time: f64,
+    step: u64,
     next_flush: f64,
     pending: BTreeMap<EntityPath, Vec<Row>>,
     pending_bytes: usize,
@@ -112,6 +113,7 @@ impl Recorder {
             ids: Ids::default(),
             time: TimePoint::STATIC,
             sim_time: 0.0,
+            step: 0,
             next_flush: Self::FLUSH_PERIOD_S,
             pending: BTreeMap::new(),
             pending_bytes: 0,
@@ -135,6 +137,7 @@ impl Recorder {
     /// Sets the time of the following log calls: simulation step and simulated seconds.
     pub fn set_time(&mut self, step: u64, sim_time: f64) {
         self.sim_time = sim_time;
+        self.step = step;
         self.time = TimePoint::default()
             .with_index(STEP, TimeCell::from_sequence(step.min(i64::MAX as u64) as i64))
             .with_index(SIM_TIME, TimeCell::from_duration_nanos((sim_time * 1e9).round() as i64));
@@ -149,6 +152,11 @@ impl Recorder {
     /// Simulated time of the following log calls, seconds.
     pub fn sim_time(&self) -> f64 {
         self.sim_time
+    }
+
+    /// Simulation step of the following log calls.
+    pub fn step(&self) -> u64 {
+        self.step
     }
 
     /// Logs `data` at `entity` at the current time.
