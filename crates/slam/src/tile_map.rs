@@ -256,15 +256,29 @@ impl TileMap {
 
     /// The map as an occupancy grid, for watching it grow: cells with hits occupied, cells only crossed by a beam's
     /// end band free, the rest unknown (free space is not traced per particle; [`crate::Rbpf::map`] builds the
-    /// output map). `None` while the map is empty or when it exceeds core's cell limit.
+    /// output map). The grid covers the allocated tiles. `None` while the map is empty or when it exceeds core's
+    /// cell limit.
     pub fn to_grid(&self) -> Option<mrslam_core::OccupancyGrid> {
-        let [x0, y0, x1, y1] = self.cell_bounds()?;
-        let (w, h) = ((x1 - x0 + 1) as usize, (y1 - y0 + 1) as usize);
-        let origin = mrslam_core::pose(x0 as f64 * self.delta, y0 as f64 * self.delta, 0.0);
+        let allocated = || {
+            let tw = self.tw;
+            self.tiles
+                .iter()
+                .enumerate()
+                .filter_map(move |(slot, t)| Some((slot as i32 % tw, slot as i32 / tw, t.as_deref()?)))
+        };
+        let (mut x0, mut y0, mut x1, mut y1) = (i32::MAX, i32::MAX, i32::MIN, i32::MIN);
+        for (tx, ty, _) in allocated() {
+            (x0, y0, x1, y1) = (x0.min(tx), y0.min(ty), x1.max(tx), y1.max(ty));
+        }
+        if x0 > x1 {
+            return None;
+        }
+        let (w, h) = (((x1 - x0 + 1) * TILE) as usize, ((y1 - y0 + 1) * TILE) as usize);
+        let (cx0, cy0) = ((self.tx0 + x0) * TILE, (self.ty0 + y0) * TILE);
+        let origin = mrslam_core::pose(cx0 as f64 * self.delta, cy0 as f64 * self.delta, 0.0);
         let mut grid = mrslam_core::OccupancyGrid::new(w, h, self.delta, origin).ok()?;
-        for (slot, tile) in self.tiles.iter().enumerate() {
-            let Some(tile) = tile else { continue };
-            let (tx, ty) = (slot as i32 % self.tw, slot as i32 / self.tw);
+        for (tx, ty, tile) in allocated() {
+            let (tx, ty) = (tx - x0, ty - y0);
             for ly in 0..TILE {
                 let (seen, occupied) = (tile.seen[ly as usize], tile.occupied[ly as usize]);
                 if seen | occupied == 0 {

@@ -115,6 +115,21 @@ impl GridStyle {
         GridStyle { occupied: [150, 150, 150, 255], free: [255, 255, 255, 18], unknown: [0, 0, 0, 0] };
 }
 
+/// A grid drawn as map_server's grey levels, one byte a cell (occupied 0, free 254, unknown 205), north-up like
+/// [`grid_rgba`]: a quarter of the bytes, for maps logged many times.
+pub fn grid_grey(grid: &OccupancyGrid) -> Vec<u8> {
+    let (w, h) = (grid.width(), grid.height());
+    let mut out = Vec::with_capacity(w * h);
+    for v in 0..h {
+        out.extend((0..w).map(|u| match grid.state(u, h - 1 - v) {
+            CellState::Occupied => 0,
+            CellState::Free => 254,
+            CellState::Unknown => 205,
+        }));
+    }
+    out
+}
+
 /// A grid drawn as RGBA pixels (row 0 = the grid's top row, so that the picture is north-up).
 pub fn grid_rgba(grid: &OccupancyGrid, style: &GridStyle) -> image::RgbaImage {
     let (w, h) = (grid.width(), grid.height());
@@ -161,6 +176,11 @@ mod tests {
         assert_eq!(img.get_pixel(0, 0).0, GridStyle::GREY.occupied);
         assert_eq!(img.get_pixel(2, 1).0, GridStyle::GREY.free);
         assert_eq!(img.get_pixel(1, 1).0, GridStyle::GREY.unknown);
+        let grey = grid_grey(&g);
+        assert_eq!(grey.len(), 6);
+        for (i, px) in img.pixels().enumerate() {
+            assert_eq!(grey[i], px.0[0], "pixel {i}: the grey picture is the RGBA one's red channel");
+        }
     }
 
     #[test]

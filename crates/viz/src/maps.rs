@@ -1,12 +1,12 @@
 //! Robots' maps as they grow, and the merge: keypoints on both maps, inlier matches, the merged map.
 
-use crate::convert::{GridStyle, Rgba, color, pose_transform, xy};
+use crate::convert::{GridStyle, Rgba, color, grid_grey, grid_image_transform, pose_transform, xy};
 use crate::recorder::Recorder;
 use crate::world::layer;
 use mrslam_core::{OccupancyGrid, Pose2};
 use nalgebra::Point2;
 use rerun::components::{DrawOrder, Radius};
-use rerun::{EntityPath, LineStrip2D, LineStrips2D, Points2D};
+use rerun::{EntityPath, Image, LineStrip2D, LineStrips2D, Points2D};
 
 /// Largest distance, metres, between the two ends of a match (placed by the truth, or by the estimate) for it to
 /// count as good.
@@ -21,6 +21,14 @@ impl Recorder {
     /// frame's pose in the parent's frame).
     pub fn log_map(&mut self, entity: &EntityPath, grid: &OccupancyGrid, frame: &Pose2, c: Rgba) {
         self.log_grid(entity, grid, frame, &GridStyle::tinted(c), layer::MAP, false);
+    }
+
+    /// Logs a map in map_server's greys, one byte a cell (see [`crate::convert::grid_grey`]), placed in `frame`, at
+    /// the current time.
+    pub fn log_grey_map(&mut self, entity: &EntityPath, grid: &OccupancyGrid, frame: &Pose2) {
+        let (w, h) = (grid.width() as u32, grid.height() as u32);
+        let image = Image::from_l8(grid_grey(grid), [w, h]).with_draw_order(DrawOrder::from(layer::MAP));
+        self.log_all(entity, &[&grid_image_transform(grid, frame), &image]);
     }
 
     /// Logs a merged map at the current time, in grey, placed in `frame`.

@@ -187,12 +187,12 @@ impl SlamLogRecorder {
         self.map_dirty && self.rec.sim_time() >= self.next_map
     }
 
-    /// Logs the map (map frame) at `maps/<name>`.
+    /// Logs the map (map frame) at `maps/<name>`, in map_server's greys.
     pub fn map(&mut self, grid: &OccupancyGrid) {
         self.next_map = self.rec.sim_time() + self.rates.map_period_s;
         self.map_dirty = false;
-        let (name, c) = (self.name.clone(), self.color);
-        self.rec.log_map(&paths::map(&name), grid, &Pose2::identity(), c);
+        let name = self.name.clone();
+        self.rec.log_grey_map(&paths::map(&name), grid, &Pose2::identity());
     }
 
     /// Logs the relations' errors: as time series at each relation's second stamp, and as dots on the path at
