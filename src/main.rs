@@ -45,6 +45,9 @@ enum Command {
     Run(cmd::run::RunArgs),
     /// Map a CARMEN log with GMapping-style particle filter SLAM.
     Slam(cmd::slam::SlamArgs),
+    /// Simulated worlds: make one from a map.
+    #[command(subcommand)]
+    World(cmd::world::WorldCommand),
     /// Studies: many seeded merge trials across overlaps; success rates with intervals, plots, shards.
     #[command(subcommand)]
     Study(cmd::study::StudyCommand),
@@ -61,6 +64,7 @@ fn main() -> ExitCode {
     };
     let result = match cli.command {
         Command::Map(c) => cmd::map::run(c),
+        Command::World(c) => cmd::world::run(c),
         Command::Log(c) => cmd::log::run(c),
         Command::Eval(c) => cmd::eval::run(c),
         Command::Merge(a) => cmd::merge::run(a),

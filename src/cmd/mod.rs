@@ -11,6 +11,7 @@ pub mod run;
 pub mod slam;
 pub mod study;
 pub mod viz;
+pub mod world;
 
 pub use paths::{check_not_input, check_output};
 

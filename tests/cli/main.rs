@@ -14,3 +14,4 @@ mod study;
 mod study_logs;
 mod util;
 mod viz;
+mod world;

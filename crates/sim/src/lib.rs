@@ -35,6 +35,7 @@ mod bitmap;
 mod drive;
 mod encoder;
 mod error;
+pub mod from_map;
 mod geometry;
 mod lidar;
 mod raycast;
