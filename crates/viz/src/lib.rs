@@ -47,5 +47,5 @@ pub use error::VizError;
 pub use metrics::Level;
 pub use recorder::{Recorder, RecordingStats};
 pub use run::{MergeView, Rates, RobotInfo, RunRecorder, SlamState};
-pub use slam_log::{LogRates, ProcessedScan, RelationMark, SlamLogRecorder};
+pub use slam_log::{ProcessedScan, RelationMark, SlamLogRecorder};
 pub use target::{DEFAULT_CONNECT, Target, partial_path};

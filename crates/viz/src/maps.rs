@@ -23,7 +23,7 @@ impl Recorder {
         self.log_grid(entity, grid, frame, &GridStyle::tinted(c), layer::MAP, false);
     }
 
-    /// Logs a map in map_server's greys, one byte a cell (see [`crate::convert::grid_grey`]), placed in `frame`, at
+    /// Logs a map in map_server's greys (occupied 0, free 254, unknown 205), one byte a cell, placed in `frame`, at
     /// the current time.
     pub fn log_grey_map(&mut self, entity: &EntityPath, grid: &OccupancyGrid, frame: &Pose2) {
         let (w, h) = (grid.width() as u32, grid.height() as u32);

@@ -6,10 +6,10 @@
 //! `sim_time` the log's time since its first scan.
 //!
 //! Throttling, so that a 45-minute log stays well under 100 MB: the pose, the particles, the scan and Neff are
-//! logged at every processed scan (a few KB each); the paths, redrawn whole, at most every
-//! [`LogRates::path_period_s`] of log time; the map at most every [`LogRates::map_period_s`], and it is the
-//! best particle's own map (hits and seen cells, cheap to take; see `Rbpf::live_map`), not the output map
-//! rebuilt from every scan, which is logged once at the end.
+//! logged at every processed scan (a few KB each); the paths, redrawn whole, and the map at most at the
+//! [`Rates::LOG`] periods of log time (2 s, 10 s). The map is the best particle's own map (hits and seen cells,
+//! cheap to take; see `Rbpf::live_map`), in one-byte greys; the output map, rebuilt from every scan, is logged
+//! once at the end.
 
 use crate::VizError;
 use crate::blueprint::{Layout, ViewKind};
@@ -17,26 +17,12 @@ use crate::convert::{Rgba, color, lighten, pose_xy, ramp, robot_color, with_alph
 use crate::metrics::Level;
 use crate::paths;
 use crate::recorder::{Recorder, RecordingStats};
+use crate::run::Rates;
 use crate::world::layer;
 use mrslam_core::{OccupancyGrid, Pose2};
 use nalgebra::Point2;
 use rerun::components::{DrawOrder, Radius};
 use rerun::{EntityPath, Points2D};
-
-/// How often the expensive things are logged, in seconds of log time.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct LogRates {
-    /// Paths (SLAM, odometry), redrawn whole.
-    pub path_period_s: f64,
-    /// The growing map.
-    pub map_period_s: f64,
-}
-
-impl Default for LogRates {
-    fn default() -> Self {
-        LogRates { path_period_s: 2.0, map_period_s: 10.0 }
-    }
-}
 
 /// A scan the filter processed, as plain data.
 pub struct ProcessedScan<'a, P: Iterator<Item = (Pose2, f64)>> {
@@ -76,7 +62,7 @@ const RELATION_SCALE_M: f64 = 0.2;
 #[derive(Debug)]
 pub struct SlamLogRecorder {
     rec: Recorder,
-    rates: LogRates,
+    rates: Rates,
     name: String,
     color: Rgba,
     slam_path: Vec<Pose2>,
@@ -94,7 +80,7 @@ impl SlamLogRecorder {
     pub fn new(rec: Recorder, name: &str) -> Self {
         let mut s = SlamLogRecorder {
             rec,
-            rates: LogRates::default(),
+            rates: Rates::LOG,
             name: name.to_string(),
             color: robot_color(0),
             slam_path: Vec::new(),
@@ -117,7 +103,7 @@ impl SlamLogRecorder {
     }
 
     /// Changes the rates.
-    pub fn with_rates(mut self, rates: LogRates) -> Self {
+    pub fn with_rates(mut self, rates: Rates) -> Self {
         self.rates = rates;
         self
     }
@@ -196,7 +182,7 @@ impl SlamLogRecorder {
     }
 
     /// Logs the relations' errors: as time series at each relation's second stamp, and as dots on the path at
-    /// its pose there, brighter for larger errors (full at [`RELATION_SCALE_M`]).
+    /// its pose there, brighter for larger errors (full at 0.2 m).
     pub fn relations(&mut self, marks: &[RelationMark]) {
         let name = self.name.clone();
         let (now, step) = (self.rec.sim_time(), self.rec.step());
