@@ -32,6 +32,9 @@ pub struct Alignment {
     pub evidence: Evidence,
     /// Weaker transforms the algorithm also found, strongest first; verification may pick one of them.
     pub alternatives: Vec<Hypothesis>,
+    /// The alternatives only challenge the first transform (the gate's rival check) and are never accepted in
+    /// its place: an answer that did not lead every other pose of a global search is not significant.
+    pub alternatives_are_rivals: bool,
 }
 
 /// One candidate transform with its support.
@@ -261,7 +264,7 @@ pub fn merge(merger: &dyn Merger, a: &OccupancyGrid, b: &OccupancyGrid, p: &Merg
     let first = hypotheses.next().expect("the primary hypothesis");
     let mut chosen = check(a, b, &walls_b, first, alignment.matched_features, p, &mut timings);
     if p.verify_enabled {
-        while chosen.reason.is_some() {
+        while chosen.reason.is_some() && !alignment.alternatives_are_rivals {
             let Some(h) = hypotheses.next() else { break };
             chosen = check(a, b, &walls_b, h, alignment.matched_features, p, &mut timings);
         }
@@ -311,6 +314,19 @@ mod tests {
     /// An algorithm that answers with fixed hypotheses.
     struct Fixed(Vec<Pose2>);
 
+    /// The same, its alternatives rivals only.
+    struct FixedRivals(Vec<Pose2>);
+
+    impl Merger for FixedRivals {
+        fn name(&self) -> &'static str {
+            "fixed"
+        }
+        fn align(&self, a: &OccupancyGrid, b: &OccupancyGrid) -> Result<Alignment, Box<NoAlignment>> {
+            let al = Fixed(self.0.clone()).align(a, b)?;
+            Ok(Alignment { alternatives_are_rivals: true, ..al })
+        }
+    }
+
     impl Merger for Fixed {
         fn name(&self) -> &'static str {
             "fixed"
@@ -326,6 +342,7 @@ mod tests {
                 timings_ms: BTreeMap::new(),
                 evidence: Evidence::default(),
                 alternatives: self.0[1..].iter().map(hyp).collect(),
+                alternatives_are_rivals: false,
             })
         }
     }
@@ -375,5 +392,16 @@ mod tests {
         p.verify.max_rival_ratio = f64::INFINITY;
         let out = merge(&Fixed(vec![Pose2::identity(), half_turn()]), &g, &g, &p);
         assert!(out.report.accepted, "{:?}", out.report.reason);
+    }
+
+    #[test]
+    fn a_rival_only_alternative_is_never_accepted_in_the_first_answers_place() {
+        let g = room(true);
+        // The first answer, 1 m off, fails the gate; the second is right.
+        let hyps = vec![pose(1.0, 0.0, 0.0), Pose2::identity()];
+        let out = merge(&Fixed(hyps.clone()), &g, &g, &MergeParams::default());
+        assert!(out.report.accepted, "{:?}", out.report.reason);
+        let out = merge(&FixedRivals(hyps), &g, &g, &MergeParams::default());
+        assert!(!out.report.accepted);
     }
 }

@@ -268,6 +268,7 @@ mod tests {
                 timings_ms: BTreeMap::new(),
                 evidence: Evidence::default(),
                 alternatives: Vec::new(),
+                alternatives_are_rivals: false,
             })
         }
     }

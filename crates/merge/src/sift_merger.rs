@@ -190,6 +190,7 @@ impl Merger for SiftMerger {
             timings_ms: timings,
             evidence,
             alternatives,
+            alternatives_are_rivals: false,
         })
     }
 }

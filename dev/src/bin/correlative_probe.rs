@@ -19,6 +19,9 @@ fn set(p: &mut CorrelativeParams, kv: &str) {
         "sigma" => p.sigma_cells = f,
         "fsigma" => p.fine_sigma_cells = f,
         "pen" => p.free_penalty = f,
+        "fpen" => p.fine_free_penalty = f,
+        "fbpen" => p.fallback_free_penalty = f,
+        "fbarea" => p.fallback_min_overlap_m2 = f,
         "depth" => p.depth = f as usize,
         "astep" => p.angle_step_scale = f,
         "pts" => p.max_points = f as usize,
@@ -32,7 +35,6 @@ fn set(p: &mut CorrelativeParams, kv: &str) {
         "area" => p.min_overlap_m2 = f,
         "par" => p.parallel = f != 0.0,
         "margin" => p.min_margin = f,
-        "clear" => p.free_clearance_m = f,
         "rdist" => p.rival_distinct_m = f,
         "rivals" => p.rivals = f as usize,
         _ => panic!("unknown key {k}"),
@@ -90,6 +92,39 @@ fn tiles(a: &OccupancyGrid, b: &OccupancyGrid, t: &Pose2) {
             d.rotation.angle().to_degrees()
         );
     }
+}
+
+/// b's walls placed by `t` on a's free cells with no wall of a within 0.4 m: how many, and the 2 m tiles (a's
+/// frame) holding most of them.
+fn contradictions(a: &OccupancyGrid, b: &OccupancyGrid, t: &Pose2) {
+    use mrslam_core::CellState;
+    let walls = mrslam_merge::dev::wall_points(b);
+    let k = (0.4 / a.resolution()).round() as i64;
+    let state = |ix: i64, iy: i64| a.get_checked(ix, iy).map(CellState::from_log_odds);
+    let (mut known, mut bad) = (0usize, 0usize);
+    let mut tiles: std::collections::BTreeMap<(i64, i64), usize> = Default::default();
+    for p in &walls {
+        let q = t * p;
+        let (ix, iy) = a.world_to_cell_i(&q);
+        match state(ix, iy) {
+            Some(CellState::Unknown) | None => continue,
+            _ => known += 1,
+        }
+        if state(ix, iy) != Some(CellState::Free) {
+            continue;
+        }
+        let near = (-k..=k).any(|dy| (-k..=k).any(|dx| state(ix + dx, iy + dy) == Some(CellState::Occupied)));
+        if !near {
+            bad += 1;
+            *tiles.entry(((q.x / 2.0).floor() as i64 * 2, (q.y / 2.0).floor() as i64 * 2)).or_default() += 1;
+        }
+    }
+    let mut v: Vec<_> = tiles.into_iter().collect();
+    v.sort_by_key(|t| std::cmp::Reverse(t.1));
+    println!(
+        "contradictions: {bad} of {known} walls of b over a's known cells lie on free space 0.4 m from any wall of a; top 2 m tiles (x, y): {:?}",
+        &v[..v.len().min(12)]
+    );
 }
 
 fn error(t: &Pose2, truth: &Pose2) -> (f64, f64) {
@@ -159,6 +194,38 @@ fn main() {
         println!("sift ok/false/refused {:?}, correlative {:?}", stats[0], stats[1]);
         return;
     }
+    if args.first().is_some_and(|s| s == "trial") {
+        // One trial of `mrslam study overlap --floorplans 8 --floorplan-size WxH` (study seed 1): `trial W H
+        // OVERLAP REP SEED [key=value ...]`, SEED as results.csv has it.
+        let v: Vec<f64> = args[1..4].iter().map(|s| s.parse().expect("number")).collect();
+        let rep: u64 = args[4].parse().expect("rep");
+        let seed: u64 = args[5].parse().expect("seed");
+        for kv in &args[6..] {
+            set(&mut p, kv);
+        }
+        let mix = |mut x: u64| {
+            x = x.wrapping_add(0x9e37_79b9_7f4a_7c15);
+            x = (x ^ (x >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+            x = (x ^ (x >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+            x ^ (x >> 31)
+        };
+        let plan_seed = mix(mix(1 ^ 0xf100_4b1a_0000_0000) ^ (rep % 8));
+        let map = generate(plan_seed, &FloorplanParams { width_m: v[0], height_m: v[1], ..FloorplanParams::default() });
+        let pair = cut_pair(&map, &PairSpec { overlap: v[2], max_shift_m: 5.0, rotate: true }, seed);
+        let cor = CorrelativeMerger::new(p);
+        if let Some(sig) = mrslam_merge::dev::significance(&cor, &pair.a, &pair.b) {
+            println!(
+                "best {:?} score {} rival {:?} score {} margin {:.3}",
+                xyt(&sig.best),
+                sig.best_score,
+                sig.rival.as_ref().map(xyt),
+                sig.rival_score,
+                sig.margin()
+            );
+        }
+        run(&cor, &pair.a, &pair.b, Some(&pair.t_a_b));
+        return;
+    }
     if args.first().is_some_and(|s| s == "gap") {
         // Gap pairs (nothing shared) and low-overlap pairs of generated plans: what separates a coincidence
         // from a true answer? Prints one line per pair: kind, size, seed, accepted (tolerance 1 / 2), error,
@@ -166,8 +233,9 @@ fn main() {
         for kv in &args[1..] {
             set(&mut p, kv);
         }
-        // The significance test off throughout: its margin is printed, each threshold judged afterwards.
-        let cor = CorrelativeMerger::new(CorrelativeParams { min_margin: 0.0, ..p });
+        // The whole merger as set (the significance test decides when the fallback search runs); the margin of
+        // its answer is printed beside.
+        let cor = CorrelativeMerger::new(p);
         for (w, h) in [(18.0, 14.0), (24.0, 18.0)] {
             for seed in 0..60u64 {
                 let map =
@@ -216,6 +284,9 @@ fn main() {
     if let Some(t) = &truth {
         let walls = mrslam_merge::dev::wall_points(&b);
         let refined = mrslam_merge::dev::refine(&a, &walls, t, &mrslam_merge::RefineParams::default());
+        if std::env::var("CONTRA").is_ok() {
+            contradictions(&a, &b, &refined);
+        }
         for (name, t) in [("truth", *t), ("truth+icp", refined)] {
             let agr = mrslam_merge::agreement(&a, &b, &t);
             println!("  wall agreement at 1..4 cells: {:?}", tolerant_walls(&a, &b, &t));

@@ -59,30 +59,11 @@ pub struct ScoreField {
 
 impl ScoreField {
     /// The field of `blocks`: [`HIT`] `· exp(-d² / 2σ²)` at distance `d` cells from the nearest wall (σ =
-    /// `sigma_cells`, cut where it rounds to 0), `-free_penalty` on free cells with no wall that near nor within
-    /// `clearance` cells (along x and y), 0 elsewhere.
-    pub fn build(blocks: &BlockStates, sigma_cells: f64, free_penalty: i16, clearance: usize) -> Self {
+    /// `sigma_cells`, cut where it rounds to 0), `-free_penalty` on free cells with no wall that near, 0 elsewhere.
+    pub fn build(blocks: &BlockStates, sigma_cells: f64, free_penalty: i16) -> Self {
         let (w, h) = (blocks.width, blocks.height);
         let mut values: Vec<i16> =
             blocks.states.iter().map(|s| if *s == CellState::Free { -free_penalty.max(0) } else { 0 }).collect();
-        if clearance > 0 && free_penalty > 0 {
-            // Free cells near a wall are not evidence against a pose: the two maps' walls may lie that far apart.
-            let c = clearance as i64;
-            for iy in 0..h {
-                for ix in 0..w {
-                    if blocks.states[iy * w + ix] != CellState::Occupied {
-                        continue;
-                    }
-                    let (y0, y1) = ((iy as i64 - c).max(0) as usize, (iy as i64 + c).min(h as i64 - 1) as usize);
-                    let (x0, x1) = ((ix as i64 - c).max(0) as usize, (ix as i64 + c).min(w as i64 - 1) as usize);
-                    for y in y0..=y1 {
-                        for v in &mut values[y * w + x0..=y * w + x1] {
-                            *v = (*v).max(0);
-                        }
-                    }
-                }
-            }
-        }
         let kernel = Kernel::gaussian(sigma_cells);
         let r = kernel.radius as i64;
         for iy in 0..h {
@@ -165,7 +146,7 @@ mod tests {
                 g.set(ix, iy, if ix == 2 { 2.0 } else { -2.0 });
             }
         }
-        let f = ScoreField::build(&BlockStates::of(&g, 1), 1.0, 7, 0);
+        let f = ScoreField::build(&BlockStates::of(&g, 1), 1.0, 7);
         assert_eq!(f.get(2, 5), HIT);
         assert!(f.get(3, 5) > 50 && f.get(3, 5) < HIT, "{}", f.get(3, 5));
         assert!(f.get(1, 5) == f.get(3, 5));

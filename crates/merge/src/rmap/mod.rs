@@ -342,6 +342,7 @@ impl RmapMerger {
                 timings_ms: timings,
                 evidence,
                 alternatives: Vec::new(),
+                alternatives_are_rivals: false,
             },
             angles: (th_a, th_b),
             triangles: found,
