@@ -45,6 +45,9 @@ enum Command {
     Run(cmd::run::RunArgs),
     /// Map a CARMEN log with GMapping-style particle filter SLAM.
     Slam(cmd::slam::SlamArgs),
+    /// The simulator against reality: replay a real log in a world.
+    #[command(subcommand)]
+    Sim(cmd::sim::SimCommand),
     /// Simulated worlds: make one from a map.
     #[command(subcommand)]
     World(cmd::world::WorldCommand),
@@ -65,6 +68,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Map(c) => cmd::map::run(c),
         Command::World(c) => cmd::world::run(c),
+        Command::Sim(c) => cmd::sim::run(c),
         Command::Log(c) => cmd::log::run(c),
         Command::Eval(c) => cmd::eval::run(c),
         Command::Merge(a) => cmd::merge::run(a),

@@ -8,6 +8,7 @@ pub mod merge;
 pub mod merge_many;
 pub mod paths;
 pub mod run;
+pub mod sim;
 pub mod slam;
 pub mod study;
 pub mod viz;

@@ -9,6 +9,7 @@ mod merge;
 mod merge_many;
 mod reliability;
 mod run;
+mod sim;
 mod slam;
 mod study;
 mod study_logs;

@@ -39,6 +39,7 @@ pub mod from_map;
 mod geometry;
 mod lidar;
 mod raycast;
+pub mod replay;
 mod sim;
 mod slip;
 mod truth;

@@ -1,0 +1,180 @@
+//! `mrslam sim replay LOG --world WORLD.toml`: the simulator's lidar checked against a real log's scans.
+
+use anyhow::{Context, Result, bail};
+use clap::{Subcommand, ValueEnum};
+use mrslam_core::relations::{self, pose_at};
+use mrslam_core::{Pose2, sensor::LidarSpec};
+use mrslam_sim::replay::{BandStats, OUTLIER_M, ReplayReport, replay};
+use mrslam_sim::{World, WorldSpec};
+use serde_json::json;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+/// Simulator subcommands.
+#[derive(Subcommand)]
+pub enum SimCommand {
+    /// Replay a log in a world: simulate each real scan from its pose, noiseless, and compare beam by beam
+    /// (residuals by range and by incidence angle, missing and extra returns, outliers), then fit the noise a
+    /// lidar model needs and compare its residuals with the real ones (two-sample Kolmogorov-Smirnov).
+    Replay {
+        /// CARMEN log.
+        log: PathBuf,
+        /// World file whose frame is the poses' frame (e.g. `mrslam world from-map` of a map of this log).
+        #[arg(long)]
+        world: PathBuf,
+        /// The robot's pose at each scan from this trajectory (`stamp x y theta`, e.g. `mrslam slam
+        /// --trajectory` with the map the world was made from); without it, the log's own laser poses (a
+        /// corrected log's are scan-matched).
+        #[arg(long)]
+        trajectory: Option<PathBuf>,
+        /// A trajectory pose belongs to a scan within this many seconds.
+        #[arg(long, default_value_t = 0.001)]
+        tolerance: f64,
+        /// The lidar model whose noise the real residuals are compared with.
+        #[arg(long, default_value_t = LidarPreset::Hokuyo)]
+        lidar: LidarPreset,
+        /// Write the report (JSON) here.
+        #[arg(long)]
+        report: Option<PathBuf>,
+        /// How to read the log.
+        #[command(flatten)]
+        read: super::log::ReadArgs,
+        /// Seed of the model residuals drawn for the comparison.
+        #[arg(long, default_value_t = 0)]
+        seed: u64,
+    },
+}
+
+/// The simulator's lidar models.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum LidarPreset {
+    /// Hokuyo URG-04LX (Experia's).
+    Hokuyo,
+    /// Slamtec RPLIDAR A1 (Prawn's).
+    Rplidar,
+}
+
+impl std::fmt::Display for LidarPreset {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            LidarPreset::Hokuyo => "hokuyo",
+            LidarPreset::Rplidar => "rplidar",
+        })
+    }
+}
+
+impl LidarPreset {
+    fn spec(self) -> LidarSpec {
+        match self {
+            LidarPreset::Hokuyo => LidarSpec::hokuyo_urg_04lx(),
+            LidarPreset::Rplidar => LidarSpec::rplidar_a1(),
+        }
+    }
+}
+
+/// Runs a sim subcommand.
+pub fn run(cmd: SimCommand) -> Result<ExitCode> {
+    match cmd {
+        SimCommand::Replay { log, world, trajectory, tolerance, lidar, report, read, seed } => {
+            let inputs: Vec<&Path> =
+                [Some(log.as_path()), Some(world.as_path()), trajectory.as_deref()].into_iter().flatten().collect();
+            if let Some(r) = &report {
+                super::paths::check_extension(r, "--report", &["json"])?;
+                super::paths::check_outputs(&[r.as_path()], &inputs)?;
+            }
+            if !(tolerance.is_finite() && tolerance >= 0.0) {
+                bail!("--tolerance {tolerance}: must be a non-negative number of seconds");
+            }
+            let spec = WorldSpec::from_toml_file(&world)?;
+            let w = World::from_spec(&spec).with_context(|| format!("{}", world.display()))?;
+            let traj = trajectory.as_deref().map(relations::read_trajectory).transpose()?;
+            let parsed = read.read(&log)?;
+            if parsed.scans.is_empty() {
+                bail!("{}: no laser scans in the log", log.display());
+            }
+            let mount = parsed.scans[0].laser_offset;
+            // The robot's pose at each scan: from the trajectory, or the logged laser pose less the mount.
+            let mut unplaced = 0;
+            let scans: Vec<(Pose2, &mrslam_core::LaserScan)> = parsed
+                .scans
+                .iter()
+                .filter_map(|r| {
+                    let pose = match &traj {
+                        Some(t) => pose_at(t, r.scan.stamp, tolerance),
+                        None => Some(r.logged_laser_pose * r.laser_offset.inverse()),
+                    };
+                    if pose.is_none() {
+                        unplaced += 1;
+                    }
+                    pose.map(|p| (p, &r.scan))
+                })
+                .collect();
+            if scans.is_empty() {
+                bail!(
+                    "{}: no scan has a pose in {} within {tolerance} s",
+                    log.display(),
+                    trajectory.as_deref().map_or("the log".into(), |p| p.display().to_string())
+                );
+            }
+            let model = lidar.spec();
+            let r = replay(&w, &mount, scans.iter().copied(), (model.range_noise_const, model.range_noise_prop), seed);
+            print!("{}", describe(&r, unplaced, lidar));
+            if let Some(path) = &report {
+                let value = json!({
+                    "log": log.display().to_string(),
+                    "world": world.display().to_string(),
+                    "trajectory": trajectory.as_ref().map(|p| p.display().to_string()),
+                    "lidar_model": lidar.to_string(),
+                    "model_noise": { "const_m": model.range_noise_const, "prop": model.range_noise_prop },
+                    "outlier_m": OUTLIER_M,
+                    "scans_without_pose": unplaced,
+                    "replay": r,
+                });
+                super::eval::write_json(path, &value)?;
+            }
+        }
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn describe(r: &ReplayReport, unplaced: usize, lidar: LidarPreset) -> String {
+    let pct = |n: usize| 100.0 * n as f64 / r.beams.max(1) as f64;
+    let mut s = format!(
+        "replay: {} scans ({unplaced} without a pose), {} beams: both returned {:.1} %, the real scan missed a \
+         surface {:.1} %, the real scan saw one the world lacks {:.1} %, neither {:.1} %\n",
+        r.scans,
+        r.beams,
+        pct(r.both),
+        pct(r.real_missing),
+        pct(r.real_extra),
+        pct(r.neither)
+    );
+    let ks = |v: Option<f64>| v.map_or("-".to_string(), |d| format!("{d:.3}"));
+    let table = |title: &str, unit: &str, bands: &[BandStats]| {
+        let mut t = format!(
+            "{title:<16} {:>8} {:>8} {:>9} {:>9} {:>8} {:>8}\n",
+            "beams", "outliers", "median m", "sigma m", "KS fit", "KS model"
+        );
+        for b in bands {
+            let band =
+                if b.to.is_finite() { format!("{}-{} {unit}", b.from, b.to) } else { format!(">= {} {unit}", b.from) };
+            t += &format!(
+                "{band:<16} {:>8} {:>8} {:>+9.4} {:>9.4} {:>8} {:>8}\n",
+                b.beams,
+                b.outliers,
+                b.median_m,
+                b.sigma_m,
+                ks(b.ks_fitted),
+                ks(b.ks_model)
+            );
+        }
+        t
+    };
+    s += &table("range", "m", &r.by_range);
+    s += &table("incidence", "deg", &r.by_incidence);
+    s += &format!(
+        "fitted noise: sigma = {:.4} m + {:.4} x range (the {lidar} model: the KS column compares with its noise)\n",
+        r.fitted_noise_const_m, r.fitted_noise_prop
+    );
+    s
+}

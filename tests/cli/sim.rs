@@ -1,0 +1,83 @@
+//! `mrslam sim replay`: a log the simulator wrote itself, with a noiseless lidar, replays in its own world with
+//! no residual; the report says so; bad inputs are refused.
+
+use crate::util::{mrslam, p, text};
+use mrslam_core::Xyt;
+use mrslam_sim::{EncoderParams, LidarModel, RobotModel, Sim, SimConfig, SlipParams, WorldSpec};
+use std::fmt::Write as _;
+use std::path::Path;
+
+const ROOM: &str = r#"
+name = "replay room"
+[[walls]]
+points = [[0, 0], [8, 0], [8, 5], [0, 5], [0, 0]]
+[[boxes]]
+center = [5, 3]
+size = [1.0, 0.6]
+angle = 0.4
+[[circles]]
+center = [2, 1.5]
+radius = 0.3
+"#;
+
+/// Drives a robot with a noiseless Hokuyo round the room and writes its scans as a CARMEN log: the laser's true
+/// pose in the FLASER line's pose fields, the lidar's geometry in PARAM lines.
+fn simulated_log(world: &Path, log: &Path) {
+    let spec = WorldSpec::from_toml_file(world).unwrap();
+    let mut sim = Sim::with_config(&spec, 1, SimConfig::default()).unwrap();
+    let mut lidar = LidarModel::hokuyo_urg_04lx().noiseless();
+    lidar.skew = false;
+    let (mount, fov, max) = (lidar.mount, (lidar.beam_count() - 1) as f64 * lidar.resolution, lidar.range_max);
+    let start = mrslam_core::pose(1.0, 3.5, -0.3);
+    let id = sim
+        .add_robot("r", RobotModel::experia(), lidar, SlipParams::default(), EncoderParams::default(), start)
+        .unwrap();
+    sim.set_velocity_command(id, 0.3, 0.2).unwrap();
+    let mut text = format!("PARAM laser_front_laser_fov {}\nPARAM robot_front_laser_max {max}\n", fov.to_degrees());
+    for step in 0..400 {
+        sim.step();
+        if step % 40 != 0 {
+            continue;
+        }
+        let scan = sim.scan_now(id).unwrap();
+        let Xyt { x, y, theta } = Xyt::from_pose(&(sim.true_pose(id).unwrap() * mount));
+        let _ = write!(text, "FLASER {}", scan.len());
+        for r in &scan.ranges {
+            let r = if r.is_finite() { *r as f64 } else { max };
+            let _ = write!(text, " {r:.5}");
+        }
+        let t = sim.time();
+        let _ = writeln!(text, " {x:.6} {y:.6} {theta:.6} {x:.6} {y:.6} {theta:.6} {t:.3} sim {t:.3}");
+    }
+    std::fs::write(log, text).unwrap();
+}
+
+#[test]
+fn the_simulators_own_log_replays_in_its_world_with_no_residual() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let (world, log, report) = (d.join("room.toml"), d.join("room.clf"), d.join("replay.json"));
+    std::fs::write(&world, ROOM).unwrap();
+    simulated_log(&world, &log);
+    let o = mrslam(&["sim", "replay", p(&log), "--world", p(&world), "--report", p(&report)]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    assert!(text(&o.stdout).contains("replay: 10 scans"), "{}", text(&o.stdout));
+    let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    let replay = &r["replay"];
+    // Only the log's 5-decimal rounding stands between the two.
+    assert!(replay["max_abs_residual_m"].as_f64().unwrap() < 1e-4, "{replay}");
+    assert_eq!((replay["real_missing"].as_u64(), replay["real_extra"].as_u64()), (Some(0), Some(0)), "{replay}");
+    assert!(replay["both"].as_u64().unwrap() > replay["beams"].as_u64().unwrap() / 2, "{replay}");
+    assert!(replay["fitted_noise_const_m"].as_f64().unwrap() < 1e-4, "{replay}");
+
+    // A trajectory without the log's stamps: refused, saying so.
+    let traj = d.join("t.txt");
+    std::fs::write(&traj, "1000.0 0 0 0\n").unwrap();
+    let o = mrslam(&["sim", "replay", p(&log), "--world", p(&world), "--trajectory", p(&traj)]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(text(&o.stderr).contains("no scan has a pose"), "{}", text(&o.stderr));
+    // A report that would overwrite the world: refused.
+    let o = mrslam(&["sim", "replay", p(&log), "--world", p(&world), "--report", p(&world)]);
+    assert_eq!(o.status.code(), Some(1));
+    assert_eq!(std::fs::read_to_string(&world).unwrap(), ROOM);
+}
