@@ -67,7 +67,7 @@ pub struct CorrelativeParams {
     /// the global search's.
     pub free_penalty: f64,
     /// [`CorrelativeParams::free_penalty`] of the fine field, which ranks the answers and decides the
-    /// significance test.
+    /// significance test (at 1 with the global search at 2, a wrong pose won both ACES pairs that need the fallback).
     pub fine_free_penalty: f64,
     /// [`CorrelativeParams::free_penalty`] of a second global search, run when the first does not settle the
     /// pair (its best is not significant, or no hypothesis shares enough known space), its answers pooled with
