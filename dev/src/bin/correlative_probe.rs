@@ -212,6 +212,14 @@ fn main() {
         let plan_seed = mix(mix(1 ^ 0xf100_4b1a_0000_0000) ^ (rep % 8));
         let map = generate(plan_seed, &FloorplanParams { width_m: v[0], height_m: v[1], ..FloorplanParams::default() });
         let pair = cut_pair(&map, &PairSpec { overlap: v[2], max_shift_m: 5.0, rotate: true }, seed);
+        if let Ok(dir) = std::env::var("WRITE") {
+            // The pair as map files, and its truth, for the file mode.
+            let dir = std::path::Path::new(&dir);
+            mrslam_core::map_io::write_ros_map(&pair.a, &dir.join("a.yaml")).expect("write a");
+            mrslam_core::map_io::write_ros_map(&pair.b, &dir.join("b.yaml")).expect("write b");
+            let t = &pair.t_a_b;
+            println!("truth {} {} {}", t.translation.x, t.translation.y, t.rotation.angle());
+        }
         let cor = CorrelativeMerger::new(p);
         if let Some(sig) = mrslam_merge::dev::significance(&cor, &pair.a, &pair.b) {
             println!(
