@@ -2,10 +2,13 @@
 
 use anyhow::{Context, Result, bail};
 use clap::{Subcommand, ValueEnum};
+use mrslam_core::ScanRecord;
 use mrslam_core::relations::{self, pose_at};
 use mrslam_core::{Pose2, sensor::LidarSpec};
+use mrslam_sim::odometry_errors::{OdometryErrors, drive_along, odometry_errors};
 use mrslam_sim::replay::{BandStats, OUTLIER_M, ReplayReport, replay};
 use mrslam_sim::{World, WorldSpec};
+use mrslam_testbed::scenario::Scenario;
 use serde_json::json;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -39,7 +42,11 @@ pub enum SimCommand {
         /// How to read the log.
         #[command(flatten)]
         read: super::log::ReadArgs,
-        /// Seed of the model residuals drawn for the comparison.
+        /// With --trajectory: also drive each robot of this scenario along the trajectory in the simulator and
+        /// compare its odometry errors (per metre, per radian) with the log's odometry against the trajectory.
+        #[arg(long, value_name = "SCENARIO.toml")]
+        scenario: Option<PathBuf>,
+        /// Seed of the model residuals drawn for the comparison, and of the simulated drives.
         #[arg(long, default_value_t = 0)]
         seed: u64,
     },
@@ -75,9 +82,15 @@ impl LidarPreset {
 /// Runs a sim subcommand.
 pub fn run(cmd: SimCommand) -> Result<ExitCode> {
     match cmd {
-        SimCommand::Replay { log, world, trajectory, tolerance, lidar, report, read, seed } => {
+        SimCommand::Replay { log, world, trajectory, tolerance, lidar, report, read, scenario, seed } => {
+            if scenario.is_some() && trajectory.is_none() {
+                bail!("--scenario: needs --trajectory (the true path the simulated robots drive)");
+            }
             let inputs: Vec<&Path> =
-                [Some(log.as_path()), Some(world.as_path()), trajectory.as_deref()].into_iter().flatten().collect();
+                [Some(log.as_path()), Some(world.as_path()), trajectory.as_deref(), scenario.as_deref()]
+                    .into_iter()
+                    .flatten()
+                    .collect();
             if let Some(r) = &report {
                 super::paths::check_extension(r, "--report", &["json"])?;
                 super::paths::check_outputs(&[r.as_path()], &inputs)?;
@@ -85,6 +98,7 @@ pub fn run(cmd: SimCommand) -> Result<ExitCode> {
             if !(tolerance.is_finite() && tolerance >= 0.0) {
                 bail!("--tolerance {tolerance}: must be a non-negative number of seconds");
             }
+            let setup = scenario.as_deref().map(Scenario::from_file).transpose()?;
             let spec = WorldSpec::from_toml_file(&world)?;
             let w = World::from_spec(&spec).with_context(|| format!("{}", world.display()))?;
             let traj = trajectory.as_deref().map(relations::read_trajectory).transpose()?;
@@ -95,7 +109,7 @@ pub fn run(cmd: SimCommand) -> Result<ExitCode> {
             let mount = parsed.scans[0].laser_offset;
             // The robot's pose at each scan: from the trajectory, or the logged laser pose less the mount.
             let mut unplaced = 0;
-            let scans: Vec<(Pose2, &mrslam_core::LaserScan)> = parsed
+            let placed: Vec<(Pose2, &ScanRecord)> = parsed
                 .scans
                 .iter()
                 .filter_map(|r| {
@@ -106,9 +120,10 @@ pub fn run(cmd: SimCommand) -> Result<ExitCode> {
                     if pose.is_none() {
                         unplaced += 1;
                     }
-                    pose.map(|p| (p, &r.scan))
+                    pose.map(|p| (p, r))
                 })
                 .collect();
+            let scans: Vec<(Pose2, &mrslam_core::LaserScan)> = placed.iter().map(|(p, r)| (*p, &r.scan)).collect();
             if scans.is_empty() {
                 bail!(
                     "{}: no scan has a pose in {} within {tolerance} s",
@@ -119,6 +134,20 @@ pub fn run(cmd: SimCommand) -> Result<ExitCode> {
             let model = lidar.spec();
             let r = replay(&w, &mount, scans.iter().copied(), (model.range_noise_const, model.range_noise_prop), seed);
             print!("{}", describe(&r, unplaced, lidar));
+            // Odometry: the log's against the trajectory, and each scenario robot's driven along it.
+            let mut odometry = Vec::new();
+            if traj.is_some() {
+                let truth: Vec<Pose2> = placed.iter().map(|(p, _)| *p).collect();
+                let odom: Vec<Pose2> = placed.iter().map(|(_, r)| r.odometry.pose).collect();
+                odometry.push(("log".to_string(), odometry_errors(&truth, &odom)));
+                let stamped: Vec<(f64, Pose2)> = placed.iter().map(|(p, r)| (r.scan.stamp, *p)).collect();
+                for robot in setup.iter().flat_map(|s| &s.robots) {
+                    let (t, o) = drive_along(robot.model.clone(), robot.slip, robot.encoder, &stamped, seed)
+                        .with_context(|| format!("driving {} along the trajectory", robot.name))?;
+                    odometry.push((format!("simulated {}", robot.name), odometry_errors(&t, &o)));
+                }
+                print!("{}", describe_odometry(&odometry));
+            }
             if let Some(path) = &report {
                 let value = json!({
                     "log": log.display().to_string(),
@@ -129,12 +158,37 @@ pub fn run(cmd: SimCommand) -> Result<ExitCode> {
                     "outlier_m": OUTLIER_M,
                     "scans_without_pose": unplaced,
                     "replay": r,
+                    "odometry": odometry.iter().map(|(n, e)| json!({ "source": n, "errors": e })).collect::<Vec<_>>(),
                 });
                 super::eval::write_json(path, &value)?;
             }
         }
     }
     Ok(ExitCode::SUCCESS)
+}
+
+fn describe_odometry(rows: &[(String, OdometryErrors)]) -> String {
+    let mut s = format!(
+        "{:<22} {:>8} {:>8} {:>26} {:>26} {:>26}\n",
+        "odometry",
+        "metres",
+        "radians",
+        "scale /m mean±std (n)",
+        "heading rad/m mean±std (n)",
+        "heading /rad mean±std (n)"
+    );
+    for (name, e) in rows {
+        let f = |x: &mrslam_sim::odometry_errors::Spread| format!("{:+.4} ± {:.4} ({})", x.mean, x.std, x.segments);
+        s += &format!(
+            "{name:<22} {:>8.1} {:>8.1} {:>26} {:>26} {:>26}\n",
+            e.metres,
+            e.radians,
+            f(&e.scale_per_m),
+            f(&e.heading_per_m),
+            f(&e.heading_per_rad)
+        );
+    }
+    s
 }
 
 fn describe(r: &ReplayReport, unplaced: usize, lidar: LidarPreset) -> String {

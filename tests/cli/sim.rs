@@ -21,8 +21,9 @@ radius = 0.3
 "#;
 
 /// Drives a robot with a noiseless Hokuyo round the room and writes its scans as a CARMEN log: the laser's true
-/// pose in the FLASER line's pose fields, the lidar's geometry in PARAM lines.
-fn simulated_log(world: &Path, log: &Path) {
+/// pose in the FLASER line's laser pose fields, the robot's in its odometry fields, the lidar's geometry in PARAM
+/// lines; and the true trajectory (`stamp x y theta`) to `trajectory`.
+fn simulated_log(world: &Path, log: &Path, trajectory: &Path) {
     let spec = WorldSpec::from_toml_file(world).unwrap();
     let mut sim = Sim::with_config(&spec, 1, SimConfig::default()).unwrap();
     let mut lidar = LidarModel::hokuyo_urg_04lx().noiseless();
@@ -33,23 +34,33 @@ fn simulated_log(world: &Path, log: &Path) {
         .add_robot("r", RobotModel::experia(), lidar, SlipParams::default(), EncoderParams::default(), start)
         .unwrap();
     sim.set_velocity_command(id, 0.3, 0.2).unwrap();
-    let mut text = format!("PARAM laser_front_laser_fov {}\nPARAM robot_front_laser_max {max}\n", fov.to_degrees());
+    let mut traj = String::new();
+    let mount_x = mount.translation.x;
+    assert!(mount.translation.y == 0.0 && mount.rotation.angle() == 0.0, "the log says only the mount's x");
+    let mut text = format!(
+        "PARAM laser_front_laser_fov {}\nPARAM robot_front_laser_max {max}\nPARAM robot_frontlaser_offset {mount_x}\n",
+        fov.to_degrees()
+    );
     for step in 0..400 {
         sim.step();
         if step % 40 != 0 {
             continue;
         }
         let scan = sim.scan_now(id).unwrap();
-        let Xyt { x, y, theta } = Xyt::from_pose(&(sim.true_pose(id).unwrap() * mount));
+        let robot = sim.true_pose(id).unwrap();
+        let Xyt { x, y, theta } = Xyt::from_pose(&(robot * mount));
+        let Xyt { x: ox, y: oy, theta: ot } = Xyt::from_pose(&robot);
         let _ = write!(text, "FLASER {}", scan.len());
         for r in &scan.ranges {
             let r = if r.is_finite() { *r as f64 } else { max };
             let _ = write!(text, " {r:.5}");
         }
         let t = sim.time();
-        let _ = writeln!(text, " {x:.6} {y:.6} {theta:.6} {x:.6} {y:.6} {theta:.6} {t:.3} sim {t:.3}");
+        let _ = writeln!(text, " {x:.6} {y:.6} {theta:.6} {ox:.6} {oy:.6} {ot:.6} {t:.3} sim {t:.3}");
+        let _ = writeln!(traj, "{t:.3} {ox:.6} {oy:.6} {ot:.6}");
     }
     std::fs::write(log, text).unwrap();
+    std::fs::write(trajectory, traj).unwrap();
 }
 
 #[test]
@@ -58,7 +69,8 @@ fn the_simulators_own_log_replays_in_its_world_with_no_residual() {
     let d = dir.path();
     let (world, log, report) = (d.join("room.toml"), d.join("room.clf"), d.join("replay.json"));
     std::fs::write(&world, ROOM).unwrap();
-    simulated_log(&world, &log);
+    let truth = d.join("truth.txt");
+    simulated_log(&world, &log, &truth);
     let o = mrslam(&["sim", "replay", p(&log), "--world", p(&world), "--report", p(&report)]);
     assert!(o.status.success(), "{}", text(&o.stderr));
     assert!(text(&o.stdout).contains("replay: 10 scans"), "{}", text(&o.stdout));
@@ -69,6 +81,32 @@ fn the_simulators_own_log_replays_in_its_world_with_no_residual() {
     assert_eq!((replay["real_missing"].as_u64(), replay["real_extra"].as_u64()), (Some(0), Some(0)), "{replay}");
     assert!(replay["both"].as_u64().unwrap() > replay["beams"].as_u64().unwrap() / 2, "{replay}");
     assert!(replay["fitted_noise_const_m"].as_f64().unwrap() < 1e-4, "{replay}");
+
+    // With the true trajectory: the same residuals, the log's odometry (the truth itself) without error, and the
+    // scenario's robots driven along it with theirs.
+    let scenario = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenarios/paper_two_rooms.toml");
+    let o = mrslam(&[
+        "sim",
+        "replay",
+        p(&log),
+        "--world",
+        p(&world),
+        "--trajectory",
+        p(&truth),
+        "--scenario",
+        p(&scenario),
+        "--report",
+        p(&report),
+    ]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    assert!(r["replay"]["max_abs_residual_m"].as_f64().unwrap() < 1e-4, "{r}");
+    let odometry = r["odometry"].as_array().unwrap();
+    let sources: Vec<&str> = odometry.iter().map(|o| o["source"].as_str().unwrap()).collect();
+    assert_eq!(sources, ["log", "simulated experia", "simulated prawn"]);
+    let log_errors = &odometry[0]["errors"];
+    assert!(log_errors["metres"].as_f64().unwrap() > 0.5, "{log_errors}");
+    assert!(log_errors["translation_per_m"]["rms"].as_f64().unwrap() < 1e-4, "{log_errors}");
 
     // A trajectory without the log's stamps: refused, saying so.
     let traj = d.join("t.txt");

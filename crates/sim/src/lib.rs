@@ -38,6 +38,7 @@ mod error;
 pub mod from_map;
 mod geometry;
 mod lidar;
+pub mod odometry_errors;
 mod raycast;
 pub mod replay;
 mod sim;
