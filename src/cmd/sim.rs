@@ -46,6 +46,12 @@ pub enum SimCommand {
         /// compare its odometry errors (per metre, per radian) with the log's odometry against the trajectory.
         #[arg(long, value_name = "SCENARIO.toml")]
         scenario: Option<PathBuf>,
+        /// Odometry errors are measured over segments of this many metres driven (or --segment-rad turned).
+        #[arg(long, default_value_t = mrslam_sim::odometry_errors::SEGMENT_M)]
+        segment_m: f64,
+        /// ... or this many radians turned, whichever comes first.
+        #[arg(long, default_value_t = mrslam_sim::odometry_errors::SEGMENT_RAD)]
+        segment_rad: f64,
         /// Seed of the model residuals drawn for the comparison, and of the simulated drives.
         #[arg(long, default_value_t = 0)]
         seed: u64,
@@ -82,7 +88,22 @@ impl LidarPreset {
 /// Runs a sim subcommand.
 pub fn run(cmd: SimCommand) -> Result<ExitCode> {
     match cmd {
-        SimCommand::Replay { log, world, trajectory, tolerance, lidar, report, read, scenario, seed } => {
+        SimCommand::Replay {
+            log,
+            world,
+            trajectory,
+            tolerance,
+            lidar,
+            report,
+            read,
+            scenario,
+            segment_m,
+            segment_rad,
+            seed,
+        } => {
+            if !(segment_m > 0.0 && segment_rad > 0.0 && segment_m.is_finite() && segment_rad.is_finite()) {
+                bail!("--segment-m {segment_m} / --segment-rad {segment_rad}: must be positive");
+            }
             if scenario.is_some() && trajectory.is_none() {
                 bail!("--scenario: needs --trajectory (the true path the simulated robots drive)");
             }
@@ -139,12 +160,13 @@ pub fn run(cmd: SimCommand) -> Result<ExitCode> {
             if traj.is_some() {
                 let truth: Vec<Pose2> = placed.iter().map(|(p, _)| *p).collect();
                 let odom: Vec<Pose2> = placed.iter().map(|(_, r)| r.odometry.pose).collect();
-                odometry.push(("log".to_string(), odometry_errors(&truth, &odom)));
+                odometry.push(("log".to_string(), odometry_errors(&truth, &odom, segment_m, segment_rad)));
                 let stamped: Vec<(f64, Pose2)> = placed.iter().map(|(p, r)| (r.scan.stamp, *p)).collect();
                 for robot in setup.iter().flat_map(|s| &s.robots) {
                     let (t, o) = drive_along(robot.model.clone(), robot.slip, robot.encoder, &stamped, seed)
                         .with_context(|| format!("driving {} along the trajectory", robot.name))?;
-                    odometry.push((format!("simulated {}", robot.name), odometry_errors(&t, &o)));
+                    odometry
+                        .push((format!("simulated {}", robot.name), odometry_errors(&t, &o, segment_m, segment_rad)));
                 }
                 print!("{}", describe_odometry(&odometry));
             }
@@ -156,6 +178,7 @@ pub fn run(cmd: SimCommand) -> Result<ExitCode> {
                     "lidar_model": lidar.to_string(),
                     "model_noise": { "const_m": model.range_noise_const, "prop": model.range_noise_prop },
                     "outlier_m": OUTLIER_M,
+                    "odometry_segments": { "metres": segment_m, "radians": segment_rad },
                     "scans_without_pose": unplaced,
                     "replay": r,
                     "odometry": odometry.iter().map(|(n, e)| json!({ "source": n, "errors": e })).collect::<Vec<_>>(),

@@ -97,6 +97,10 @@ fn the_simulators_own_log_replays_in_its_world_with_no_residual() {
         p(&scenario),
         "--report",
         p(&report),
+        "--segment-m",
+        "0.25",
+        "--segment-rad",
+        "0.25",
     ]);
     assert!(o.status.success(), "{}", text(&o.stderr));
     let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
@@ -106,7 +110,9 @@ fn the_simulators_own_log_replays_in_its_world_with_no_residual() {
     assert_eq!(sources, ["log", "simulated experia", "simulated prawn"]);
     let log_errors = &odometry[0]["errors"];
     assert!(log_errors["metres"].as_f64().unwrap() > 0.5, "{log_errors}");
+    assert!(log_errors["translation_per_m"]["segments"].as_u64().unwrap() >= 3, "{log_errors}");
     assert!(log_errors["translation_per_m"]["rms"].as_f64().unwrap() < 1e-4, "{log_errors}");
+    assert!(log_errors["scale_per_m"]["rms"].as_f64().unwrap() < 1e-4, "{log_errors}");
 
     // A trajectory without the log's stamps: refused, saying so.
     let traj = d.join("t.txt");
