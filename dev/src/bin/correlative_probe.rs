@@ -37,6 +37,7 @@ fn set(p: &mut CorrelativeParams, kv: &str) {
         "margin" => p.min_margin = f,
         "rdist" => p.rival_distinct_m = f,
         "rivals" => p.rivals = f as usize,
+        "fbrivals" => p.fallback_rivals = f as usize,
         _ => panic!("unknown key {k}"),
     }
 }
