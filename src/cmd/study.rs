@@ -13,7 +13,7 @@ use mrslam_merge::floorplan::FloorplanParams;
 use mrslam_slam::Preset;
 use mrslam_studies::journal::{Journal, StudyParams, collect_params, fingerprint};
 use mrslam_studies::logs::{self, PairRow, ScoreParams};
-use mrslam_studies::overlap::{MapSource, OverlapStudy, run_overlap_study};
+use mrslam_studies::overlap::{MapSource, MapStyle, OverlapStudy, run_overlap_study};
 use mrslam_studies::results::{TrialRow, collect, sort_rows};
 use mrslam_studies::summary::{summarise, table};
 use mrslam_studies::{self as study, Progress, Shard, StudyError, Sweep, parse_range, run_sweep};
@@ -83,6 +83,13 @@ pub struct OverlapArgs {
     /// Largest shift of the moved half of a pair, metres.
     #[arg(long, default_value_t = 5.0)]
     pub max_shift: f64,
+    /// How the pairs store walls: `walls` (occupied cells, as cut) or `boundary` (walls dropped to unknown in
+    /// both maps: the structure only in the free/unknown boundary, as map_server reads light-grey walls).
+    #[arg(long, default_value = "walls", value_parser = ["walls", "boundary"])]
+    pub map_style: String,
+    /// The SIFT merger's map-to-image encoding: `walls` (the default) or `paper` (unknown grey).
+    #[arg(long, default_value = "walls", value_parser = ["walls", "paper"])]
+    pub encoding: String,
     /// No progress bar.
     #[arg(long)]
     pub quiet: bool,
@@ -326,6 +333,8 @@ fn overlap(a: OverlapArgs) -> Result<ExitCode> {
         max_translation_cells: a.max_translation_cells,
         max_shift_m: a.max_shift,
         shard,
+        style: if a.map_style == "boundary" { MapStyle::Boundary } else { MapStyle::Walls },
+        encoding: if a.encoding == "paper" { MapEncoding::PAPER } else { MapEncoding::WALLS },
     };
     study.validate()?;
     let overlaps: Vec<String> = study.overlaps.iter().map(|o| o.to_string()).collect();
@@ -338,7 +347,9 @@ fn overlap(a: OverlapArgs) -> Result<ExitCode> {
         .set("seed", a.seed)
         .set("max_rotation_deg", a.max_rotation_deg)
         .set("max_translation_cells", a.max_translation_cells)
-        .set("max_shift", a.max_shift);
+        .set("max_shift", a.max_shift)
+        .set("map_style", &a.map_style)
+        .set("encoding", &a.encoding);
     let (journal, earlier) = open_study(&a.out, &params, algorithms.len(), a.resume)?;
     let selected: Vec<usize> = study.selected_trials().iter().map(|t| t.trial).collect();
     let (rows, n, seconds) = run_study(earlier, journal, &selected, &algorithms, a.quiet, "overlap study", |p| {

@@ -237,3 +237,23 @@ fn collect_refuses_shards_of_different_studies() {
     let o = mrslam(&["study", "collect", s0.to_str().unwrap(), "--out", s0.to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(1));
 }
+
+#[test]
+fn the_map_style_and_encoding_are_recorded_and_change_what_the_merger_sees() {
+    let dir = tempfile::tempdir().unwrap();
+    let (walls, boundary) = (dir.path().join("walls"), dir.path().join("boundary"));
+    ok(&small_study(&walls, &[]));
+    ok(&small_study(&boundary, &["--map-style", "boundary", "--encoding", "paper"]));
+    let json = std::fs::read_to_string(boundary.join("study.json")).unwrap();
+    assert!(json.contains("\"map_style\"") && json.contains("\"boundary\""), "{json}");
+    assert!(json.contains("\"encoding\"") && json.contains("\"paper\""), "{json}");
+    // Same pairs (the overlaps are measured on the cut), different maps: the merges differ.
+    let (_, a) = csv(&walls.join("results.csv"));
+    let (_, b) = csv(&boundary.join("results.csv"));
+    assert_eq!(a.len(), b.len());
+    assert!(a.iter().zip(&b).all(|(x, y)| x[2] == y[2]), "the same pairs in both");
+    assert_ne!(a, b, "dropping the walls changed nothing");
+    // Resuming with another style is refused: it would mix two studies.
+    let o = small_study(&boundary, &["--resume"]);
+    assert_eq!(o.status.code(), Some(1));
+}

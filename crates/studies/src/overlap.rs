@@ -1,15 +1,15 @@
 //! Map-level studies: cut ground-truth maps into pairs of chosen overlap, merge each pair with every
 //! algorithm through the verification gate, score against the pair's true transform.
 
-use super::algorithms::{check_algorithms, study_merger};
+use super::algorithms::{check_algorithms, study_merger_encoded};
 use super::results::{TrialRow, sort_rows};
 use super::shard::Shard;
 use super::trial::{TrialSpec, mix, trials};
 use super::{Progress, StudyError};
-use mrslam_core::OccupancyGrid;
+use mrslam_core::{CellState, OccupancyGrid};
 use mrslam_merge::floorplan::{FloorplanParams, generate};
 use mrslam_merge::pairs::{PairSpec, cut_pair};
-use mrslam_merge::{Algorithm, MergeParams, merge};
+use mrslam_merge::{Algorithm, MapEncoding, MergeParams, merge};
 use mrslam_testbed::eval::transform_error;
 use rayon::prelude::*;
 
@@ -48,6 +48,46 @@ pub struct OverlapStudy {
     pub max_shift_m: f64,
     /// Which trials this process runs.
     pub shard: Shard,
+    /// How the pair's maps store their walls.
+    pub style: MapStyle,
+    /// The SIFT merger's map-to-image encoding.
+    pub encoding: MapEncoding,
+}
+
+/// How a pair's maps store their walls.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum MapStyle {
+    /// As cut: walls are occupied cells.
+    #[default]
+    Walls,
+    /// Walls dropped to unknown in both maps, as map_server reads a map whose walls were stored light grey (between
+    /// its thresholds) or as glass leaves them: the structure is only the boundary between free and unknown.
+    Boundary,
+}
+
+impl MapStyle {
+    /// The style's name on the command line and in study.json.
+    pub fn name(self) -> &'static str {
+        match self {
+            MapStyle::Walls => "walls",
+            MapStyle::Boundary => "boundary",
+        }
+    }
+
+    /// `grid` in this style.
+    pub fn apply(self, grid: &OccupancyGrid) -> OccupancyGrid {
+        let mut g = grid.clone();
+        if self == MapStyle::Boundary {
+            for y in 0..g.height() {
+                for x in 0..g.width() {
+                    if g.state(x, y) == CellState::Occupied {
+                        g.set(x, y, 0.0);
+                    }
+                }
+            }
+        }
+        g
+    }
 }
 
 impl OverlapStudy {
@@ -124,13 +164,14 @@ pub fn run_overlap_study(study: &OverlapStudy, progress: &dyn Progress) -> Resul
 /// One trial: cut the pair, merge it with every algorithm, score.
 fn run_trial(study: &OverlapStudy, map: &OccupancyGrid, t: &TrialSpec) -> Vec<TrialRow> {
     let spec = PairSpec { overlap: t.overlap_target, max_shift_m: study.max_shift_m, rotate: true };
-    let pair = cut_pair(map, &spec, t.seed);
+    let mut pair = cut_pair(map, &spec, t.seed);
+    (pair.a, pair.b) = (study.style.apply(&pair.a), study.style.apply(&pair.b));
     let max_translation_m = study.max_translation_cells * map.resolution();
     study
         .algorithms
         .iter()
         .map(|&algorithm| {
-            let merger = study_merger(algorithm, t.seed);
+            let merger = study_merger_encoded(algorithm, t.seed, study.encoding);
             let out = merge(merger.as_ref(), &pair.a, &pair.b, &MergeParams::default());
             let err = out.report.transform.map(|x| transform_error(&x.to_pose(), &pair.t_a_b));
             let accepted = out.report.accepted;
@@ -159,6 +200,22 @@ fn run_trial(study: &OverlapStudy, map: &OccupancyGrid, t: &TrialSpec) -> Vec<Tr
 mod tests {
     use super::*;
 
+    #[test]
+    fn the_boundary_style_drops_the_walls_and_keeps_the_rest() {
+        let plan = generate(5, &FloorplanParams { width_m: 10.0, height_m: 8.0, ..FloorplanParams::default() });
+        let cells = |g: &OccupancyGrid, s: CellState| {
+            (0..g.height())
+                .flat_map(|y| (0..g.width()).map(move |x| (x, y)))
+                .filter(|&(x, y)| g.state(x, y) == s)
+                .count()
+        };
+        assert!(cells(&plan, CellState::Occupied) > 100);
+        let b = MapStyle::Boundary.apply(&plan);
+        assert_eq!(cells(&b, CellState::Occupied), 0);
+        assert_eq!(cells(&b, CellState::Free), cells(&plan, CellState::Free));
+        assert_eq!(MapStyle::Walls.apply(&plan), plan);
+    }
+
     fn small() -> OverlapStudy {
         OverlapStudy {
             source: MapSource::Floorplans {
@@ -173,6 +230,8 @@ mod tests {
             max_translation_cells: 2.0,
             max_shift_m: 3.0,
             shard: Shard::ALL,
+            style: MapStyle::Walls,
+            encoding: MapEncoding::default(),
         }
     }
 
