@@ -58,6 +58,10 @@ pub struct MergeArgs {
     /// (1: the 3x3 neighbourhood, the gate before 2026-12-02; 2 lets the walls of two robots' SLAM runs meet).
     #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u32).range(0..=4))]
     pub wall_tolerance: u32,
+    /// Take the maps as they are: no walls for a map that does not mark them (by default such a map, with almost
+    /// no occupied cells, gets walls where its free space meets unknown; the paper's merger has no such step).
+    #[arg(long)]
+    pub no_boundary_walls: bool,
     /// The correlative merger's significance test: its best pose must score this share above every pose clearly
     /// apart from it (Lowe's ratio test), else the merge is refused as ambiguous, naming the rival; 0 turns the
     /// test off [default: `CorrelativeParams::default().min_margin`, 0.15].
@@ -157,7 +161,12 @@ pub fn run(args: MergeArgs) -> Result<ExitCode> {
             Box::new(CorrelativeMerger::new(cp))
         }
     };
-    let mut mp = MergeParams { verify_enabled: !args.no_verify, fusion: args.fusion, ..MergeParams::default() };
+    let mut mp = MergeParams {
+        verify_enabled: !args.no_verify,
+        fusion: args.fusion,
+        boundary_walls: !args.no_boundary_walls,
+        ..MergeParams::default()
+    };
     mp.verify.wall_tolerance_cells = args.wall_tolerance as usize;
     if !args.more.is_empty() {
         return super::merge_many::run(&args, vec![a, b], merger.as_ref(), &mp);

@@ -28,6 +28,7 @@
 #![deny(missing_docs)]
 
 mod algorithm;
+pub mod boundary_walls;
 mod correlative;
 mod estimate;
 pub mod floorplan;

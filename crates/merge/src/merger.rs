@@ -93,6 +93,10 @@ pub struct MergeParams {
     pub fusion: FusionRule,
     /// Wall ICP applied to the algorithm's transform before verification.
     pub refine: RefineParams,
+    /// Give a map that does not mark its walls (map_server's light-grey walls, glass) walls where its free space
+    /// meets unknown, for the alignment and the gate ([`crate::boundary_walls`]); false: maps as they are (the
+    /// paper's behaviour). The merged map is fused from the maps as given.
+    pub boundary_walls: bool,
 }
 
 impl Default for MergeParams {
@@ -102,6 +106,7 @@ impl Default for MergeParams {
             verify_enabled: true,
             fusion: FusionRule::LogOddsSum,
             refine: RefineParams::default(),
+            boundary_walls: true,
         }
     }
 }
@@ -227,6 +232,12 @@ fn pose_difference(t1: &Pose2, t2: &Pose2) -> (f64, f64) {
 /// Runs an algorithm, verifies its answer against both maps, and fuses them when it passes.
 pub fn merge(merger: &dyn Merger, a: &OccupancyGrid, b: &OccupancyGrid, p: &MergeParams) -> MergeOutcome {
     let start = Instant::now();
+    // Maps that do not mark their walls get them from their free/unknown boundary; the fusion takes the maps as given.
+    let (given_a, given_b) = (a, b);
+    let walled =
+        |g: &OccupancyGrid| if p.boundary_walls { crate::boundary_walls::walls_from_boundary(g) } else { None };
+    let (walled_a, walled_b) = (walled(a), walled(b));
+    let (a, b) = (walled_a.as_ref().unwrap_or(a), walled_b.as_ref().unwrap_or(b));
     let alignment = match merger.align(a, b) {
         Ok(al) => al,
         Err(no) => {
@@ -283,7 +294,7 @@ pub fn merge(merger: &dyn Merger, a: &OccupancyGrid, b: &OccupancyGrid, p: &Merg
     alignment.inliers = hypothesis.inliers;
     let merged = reason.is_none().then(|| {
         let t = Instant::now();
-        let g = fuse(a, b, &alignment.transform, p.fusion);
+        let g = fuse(given_a, given_b, &alignment.transform, p.fusion);
         timings.insert("fuse".into(), ms(t));
         g
     });

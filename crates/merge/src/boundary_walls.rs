@@ -1,0 +1,112 @@
+//! Walls for maps that do not mark them. A map stored the map_server way with its walls light grey (between the
+//! free and occupied thresholds), or mapped through glass, holds almost no occupied cells: its structure is only the
+//! boundary between free and unknown space. Every merger here and the verification gate look at walls, so such a map
+//! is given walls where its free space meets unknown, before anything else; a map that marks its walls is left as
+//! it is.
+
+use mrslam_core::map_io::ROS_LOGODDS_LIMIT;
+use mrslam_core::{CellState, OccupancyGrid};
+
+/// A map with fewer occupied cells than this fraction of its free/unknown boundary cells does not mark its walls.
+/// (A SLAM map or a floor plan has more occupied cells than boundary cells: its free space ends at walls, and meets
+/// unknown only at frontiers, doors and windows.)
+pub const BOUNDARY_STYLE_RATIO: f64 = 0.1;
+
+/// Unknown cells that touch a free cell (4-neighbourhood): where the walls of a map that does not mark them are.
+fn boundary_cells(grid: &OccupancyGrid) -> Vec<(usize, usize)> {
+    let (w, h) = (grid.width(), grid.height());
+    let free = |x: usize, y: usize| grid.state(x, y) == CellState::Free;
+    let mut out = Vec::new();
+    for y in 0..h {
+        for x in 0..w {
+            if grid.state(x, y) != CellState::Unknown {
+                continue;
+            }
+            let touches = (x > 0 && free(x - 1, y))
+                || (x + 1 < w && free(x + 1, y))
+                || (y > 0 && free(x, y - 1))
+                || (y + 1 < h && free(x, y + 1));
+            if touches {
+                out.push((x, y));
+            }
+        }
+    }
+    out
+}
+
+/// `grid` with walls where its free space meets unknown, when it does not mark its walls (fewer occupied cells than
+/// [`BOUNDARY_STYLE_RATIO`] of its boundary cells); `None` when it does (use it as it is).
+pub fn walls_from_boundary(grid: &OccupancyGrid) -> Option<OccupancyGrid> {
+    let boundary = boundary_cells(grid);
+    let occupied = grid.cells().iter().filter(|&&l| CellState::from_log_odds(l) == CellState::Occupied).count();
+    if boundary.is_empty() || occupied as f64 >= BOUNDARY_STYLE_RATIO * boundary.len() as f64 {
+        return None;
+    }
+    let mut g = grid.clone();
+    for (x, y) in boundary {
+        g.set(x, y, ROS_LOGODDS_LIMIT);
+    }
+    Some(g)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::floorplan::{FloorplanParams, generate};
+    use crate::pairs::{PairSpec, cut_pair};
+    use crate::{MergeParams, SiftMerger, SiftMergerParams, merge};
+
+    fn drop_walls(g: &OccupancyGrid) -> OccupancyGrid {
+        let mut bare = g.clone();
+        for y in 0..bare.height() {
+            for x in 0..bare.width() {
+                if bare.state(x, y) == CellState::Occupied {
+                    bare.set(x, y, 0.0);
+                }
+            }
+        }
+        bare
+    }
+
+    fn count(g: &OccupancyGrid, s: CellState) -> usize {
+        (0..g.height()).flat_map(|y| (0..g.width()).map(move |x| (x, y))).filter(|&(x, y)| g.state(x, y) == s).count()
+    }
+
+    #[test]
+    fn a_plan_with_walls_is_left_alone_and_without_them_gets_them_back() {
+        let plan = generate(5, &FloorplanParams { width_m: 12.0, height_m: 9.0, ..FloorplanParams::default() });
+        assert!(walls_from_boundary(&plan).is_none(), "a floor plan marks its walls");
+        // The same plan with its walls dropped to unknown: walls come back around the free space.
+        let bare = drop_walls(&plan);
+        let walled = walls_from_boundary(&bare).expect("a map without walls");
+        assert_eq!(count(&walled, CellState::Free), count(&plan, CellState::Free), "free space untouched");
+        // Every new wall lies where a wall of the plan was (the plan's walls bound its free space).
+        let (mut on, mut all) = (0, 0);
+        for y in 0..walled.height() {
+            for x in 0..walled.width() {
+                if walled.state(x, y) == CellState::Occupied {
+                    all += 1;
+                    on += (plan.state(x, y) == CellState::Occupied) as usize;
+                }
+            }
+        }
+        assert!(all > 100 && on as f64 > 0.95 * all as f64, "{on} of {all} new walls on the plan's walls");
+    }
+
+    #[test]
+    fn a_pair_without_walls_merges_with_the_defaults_and_not_without_boundary_walls() {
+        let plan = generate(7, &FloorplanParams { width_m: 24.0, height_m: 18.0, ..FloorplanParams::default() });
+        let pair = cut_pair(&plan, &PairSpec { overlap: 0.5, max_shift_m: 3.0, rotate: true }, 7);
+        let (a, b) = (drop_walls(&pair.a), drop_walls(&pair.b));
+        let merger = SiftMerger::new(SiftMergerParams::default());
+        let out = merge(&merger, &a, &b, &MergeParams::default());
+        assert!(out.report.accepted, "{:?}", out.report.reason);
+        let t = out.report.transform.unwrap().to_pose();
+        let err = t.inv_mul(&pair.t_a_b);
+        assert!(err.translation.vector.norm() < 0.1 && err.rotation.angle().abs() < 0.02, "{err:?}");
+        let merged = out.merged.unwrap();
+        assert_eq!(count(&merged, CellState::Occupied), 0, "the merged map is fused from the maps as given");
+        let off = MergeParams { boundary_walls: false, ..MergeParams::default() };
+        assert!(!merge(&merger, &a, &b, &off).report.accepted, "the maps as they are have nothing to merge on");
+    }
+}
