@@ -1,13 +1,13 @@
 //! `mrslam sim replay LOG --world WORLD.toml`: the simulator's lidar checked against a real log's scans.
 
 use anyhow::{Context, Result, bail};
-use clap::{Subcommand, ValueEnum};
+use clap::Subcommand;
+use mrslam_core::Pose2;
 use mrslam_core::ScanRecord;
 use mrslam_core::relations::{self, pose_at};
-use mrslam_core::{Pose2, sensor::LidarSpec};
 use mrslam_sim::odometry_errors::{OdometryErrors, drive_along, odometry_errors};
 use mrslam_sim::replay::{BandStats, OUTLIER_M, ReplayReport, replay};
-use mrslam_sim::{World, WorldSpec};
+use mrslam_sim::{LidarModel, World, WorldSpec};
 use mrslam_testbed::scenario::Scenario;
 use serde_json::json;
 use std::path::{Path, PathBuf};
@@ -34,8 +34,8 @@ pub enum SimCommand {
         #[arg(long, default_value_t = 0.001)]
         tolerance: f64,
         /// The lidar model whose noise the real residuals are compared with.
-        #[arg(long, default_value_t = LidarPreset::Hokuyo)]
-        lidar: LidarPreset,
+        #[arg(long, default_value = "hokuyo_urg_04lx", value_parser = LidarModel::PRESETS)]
+        lidar: String,
         /// Write the report (JSON) here.
         #[arg(long)]
         report: Option<PathBuf>,
@@ -56,33 +56,6 @@ pub enum SimCommand {
         #[arg(long, default_value_t = 0)]
         seed: u64,
     },
-}
-
-/// The simulator's lidar models.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum LidarPreset {
-    /// Hokuyo URG-04LX (Experia's).
-    Hokuyo,
-    /// Slamtec RPLIDAR A1 (Prawn's).
-    Rplidar,
-}
-
-impl std::fmt::Display for LidarPreset {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(match self {
-            LidarPreset::Hokuyo => "hokuyo",
-            LidarPreset::Rplidar => "rplidar",
-        })
-    }
-}
-
-impl LidarPreset {
-    fn spec(self) -> LidarSpec {
-        match self {
-            LidarPreset::Hokuyo => LidarSpec::hokuyo_urg_04lx(),
-            LidarPreset::Rplidar => LidarSpec::rplidar_a1(),
-        }
-    }
 }
 
 /// Runs a sim subcommand.
@@ -152,9 +125,9 @@ pub fn run(cmd: SimCommand) -> Result<ExitCode> {
                     trajectory.as_deref().map_or("the log".into(), |p| p.display().to_string())
                 );
             }
-            let model = lidar.spec();
+            let model = LidarModel::preset(&lidar).context("a lidar preset that clap let through")?;
             let r = replay(&w, &mount, scans.iter().copied(), (model.range_noise_const, model.range_noise_prop), seed);
-            print!("{}", describe(&r, unplaced, lidar));
+            print!("{}", describe(&r, unplaced, &lidar));
             // Odometry: the log's against the trajectory, and each scenario robot's driven along it.
             let mut odometry = Vec::new();
             if traj.is_some() {
@@ -175,7 +148,7 @@ pub fn run(cmd: SimCommand) -> Result<ExitCode> {
                     "log": log.display().to_string(),
                     "world": world.display().to_string(),
                     "trajectory": trajectory.as_ref().map(|p| p.display().to_string()),
-                    "lidar_model": lidar.to_string(),
+                    "lidar_model": lidar,
                     "model_noise": { "const_m": model.range_noise_const, "prop": model.range_noise_prop },
                     "outlier_m": OUTLIER_M,
                     "odometry_segments": { "metres": segment_m, "radians": segment_rad },
@@ -214,7 +187,7 @@ fn describe_odometry(rows: &[(String, OdometryErrors)]) -> String {
     s
 }
 
-fn describe(r: &ReplayReport, unplaced: usize, lidar: LidarPreset) -> String {
+fn describe(r: &ReplayReport, unplaced: usize, lidar: &str) -> String {
     let pct = |n: usize| 100.0 * n as f64 / r.beams.max(1) as f64;
     let mut s = format!(
         "replay: {} scans ({unplaced} without a pose), {} beams: both returned {:.1} %, the real scan missed a \

@@ -206,17 +206,18 @@ pub fn run(args: SlamArgs) -> Result<ExitCode> {
     let secs = start.elapsed().as_secs_f64();
     let map = filter.map().context("building the map")?;
     map_io::write_ros_map(&map, &args.output).with_context(|| format!("{}", args.output.display()))?;
-    let score = rels.as_ref().map(|r| relations::score(&trajectory_of(&log.scans, &run.poses), r, args.tolerance));
+    // A pose for every scan: the filter's at the processed ones, odometry in between.
+    let trajectory: Vec<StampedPose> =
+        log.scans.iter().zip(&run.poses).map(|(r, &pose)| StampedPose { stamp: r.scan.stamp, pose }).collect();
+    let score = rels.as_ref().map(|r| relations::score(&trajectory, r, args.tolerance));
     if let Some(mut v) = viz.take() {
         record_the_end(&mut v, &filter, &map, &run, &log.scans, score.as_ref())?;
         let stats = v.finish()?;
         println!("rerun: {} ({} rows in {} chunks)", args.viz.describe(), stats.rows, stats.chunks);
     }
 
-    // A pose for every scan: the filter's at the processed ones, odometry in between.
     let (poses, processed, loops) = (run.poses, run.processed, run.loop_closure);
     let stamps: Vec<f64> = log.scans.iter().map(|r| r.scan.stamp).collect();
-    let trajectory = trajectory_of(&log.scans, &poses);
     // The preview beside the map: the map with the best particle's path (a pose per scan) in red.
     let path: Vec<nalgebra::Point2<f64>> = poses.iter().map(|p| p.translation.vector.into()).collect();
     let preview = map_io::preview_path(&args.output);
@@ -347,11 +348,6 @@ pub fn run(args: SlamArgs) -> Result<ExitCode> {
         super::eval::write_json(path, &summary)?;
     }
     Ok(ExitCode::SUCCESS)
-}
-
-/// A pose for every scan: the scans' stamps with `poses`.
-fn trajectory_of(scans: &[mrslam_core::ScanRecord], poses: &[Pose2]) -> Vec<StampedPose> {
-    scans.iter().zip(poses).map(|(r, &pose)| StampedPose { stamp: r.scan.stamp, pose }).collect()
 }
 
 /// Records the end of the run: the loop closure, the final paths (smoothed), the output map, the relations.

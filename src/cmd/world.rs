@@ -2,8 +2,8 @@
 
 use anyhow::{Context, Result, bail};
 use clap::Subcommand;
+use mrslam_core::Xyt;
 use mrslam_core::map_io::write_file_atomic;
-use mrslam_core::{CellState, Xyt};
 use mrslam_sim::from_map::{START_CLEARANCE_M, start_poses, world_toml};
 use mrslam_sim::{World, WorldSpec};
 use std::path::{Path, PathBuf};
@@ -40,10 +40,7 @@ fn from_map(map: &Path, output: &Path, clearance: f64) -> Result<ExitCode> {
         bail!("--clearance {clearance}: must be a positive number of metres");
     }
     let grid = super::map::read_yaml_map(map)?;
-    let occupied = (0..grid.height())
-        .flat_map(|y| (0..grid.width()).map(move |x| (x, y)))
-        .filter(|&(x, y)| grid.state(x, y) == CellState::Occupied)
-        .count();
+    let (_, occupied, _) = grid.state_counts();
     if occupied == 0 {
         bail!("{}: no occupied cell: a world made from it would have no obstacle", map.display());
     }

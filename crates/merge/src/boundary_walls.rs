@@ -38,7 +38,7 @@ fn boundary_cells(grid: &OccupancyGrid) -> Vec<(usize, usize)> {
 /// [`BOUNDARY_STYLE_RATIO`] of its boundary cells); `None` when it does (use it as it is).
 pub fn walls_from_boundary(grid: &OccupancyGrid) -> Option<OccupancyGrid> {
     let boundary = boundary_cells(grid);
-    let occupied = grid.cells().iter().filter(|&&l| CellState::from_log_odds(l) == CellState::Occupied).count();
+    let (_, occupied, _) = grid.state_counts();
     if boundary.is_empty() || occupied as f64 >= BOUNDARY_STYLE_RATIO * boundary.len() as f64 {
         return None;
     }

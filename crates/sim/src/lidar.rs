@@ -76,6 +76,18 @@ impl LidarModel {
         Self::from_spec(&LidarSpec::rplidar_a1(), Pose2::identity())
     }
 
+    /// The names of the presets, as scenario files and the command line give them.
+    pub const PRESETS: [&'static str; 2] = ["hokuyo_urg_04lx", "rplidar_a1"];
+
+    /// The preset called `name` (one of [`LidarModel::PRESETS`]).
+    pub fn preset(name: &str) -> Option<Self> {
+        match name {
+            "hokuyo_urg_04lx" => Some(Self::hokuyo_urg_04lx()),
+            "rplidar_a1" => Some(Self::rplidar_a1()),
+            _ => None,
+        }
+    }
+
     /// The same model without any noise, jitter or dropouts (geometry only).
     pub fn noiseless(mut self) -> Self {
         self.range_noise_const = 0.0;

@@ -123,20 +123,16 @@ pub fn replay<'a>(
     }
     r.both = beams.len();
     r.max_abs_residual_m = beams.iter().map(|b| b.residual.abs()).fold(0.0, f64::max);
-    r.by_range = bands(&beams, &RANGE_BANDS_M, |b| Some(b.sim));
+    let by_range = group(&beams, &RANGE_BANDS_M, |b| Some(b.sim));
+    let by_incidence = group(&beams, &INCIDENCE_BANDS_DEG, |b| b.incidence_deg);
+    r.by_range = band_stats(&by_range, &RANGE_BANDS_M);
+    r.by_incidence = band_stats(&by_incidence, &INCIDENCE_BANDS_DEG);
     let (a, b) = fit_noise(&r.by_range);
     (r.fitted_noise_const_m, r.fitted_noise_prop) = (a, b);
-    r.by_incidence = bands(&beams, &INCIDENCE_BANDS_DEG, |b| b.incidence_deg);
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    for (stats, edges, key) in [
-        (&mut r.by_range, &RANGE_BANDS_M[..], (|b: &Beam| Some(b.sim)) as fn(&Beam) -> Option<f64>),
-        (&mut r.by_incidence, &INCIDENCE_BANDS_DEG[..], |b: &Beam| b.incidence_deg),
-    ] {
-        for (k, s) in stats.iter_mut().enumerate() {
-            let inliers: Vec<&Beam> = beams
-                .iter()
-                .filter(|b| key(b).is_some_and(|v| band_of(edges, v) == k) && b.residual.abs() <= OUTLIER_M)
-                .collect();
+    for (stats, groups) in [(&mut r.by_range, &by_range), (&mut r.by_incidence, &by_incidence)] {
+        for (s, members) in stats.iter_mut().zip(groups) {
+            let inliers: Vec<&Beam> = members.iter().copied().filter(|b| b.residual.abs() <= OUTLIER_M).collect();
             let real: Vec<f64> = inliers.iter().map(|b| b.residual).collect();
             let bias = s.median_m;
             let mut draw = |(a, b): (f64, f64), bias: f64| -> Vec<f64> {
@@ -174,14 +170,24 @@ fn incidence(scan: &LaserScan, sensor: &Pose2, i: usize) -> Option<f64> {
     Some(90.0 - cos.acos().to_degrees().min(180.0 - cos.acos().to_degrees()))
 }
 
-fn band_of(edges: &[f64], v: f64) -> usize {
-    edges.iter().rposition(|&e| v >= e).unwrap_or(0)
+/// The beams in each band of `edges` (lower edges, the last open) by `key`, in beam order; beams without a key in
+/// none.
+fn group<'a>(beams: &'a [Beam], edges: &[f64], key: impl Fn(&Beam) -> Option<f64>) -> Vec<Vec<&'a Beam>> {
+    let mut groups = vec![Vec::new(); edges.len()];
+    for b in beams {
+        if let Some(v) = key(b) {
+            groups[edges.iter().rposition(|&e| v >= e).unwrap_or(0)].push(b);
+        }
+    }
+    groups
 }
 
-fn bands(beams: &[Beam], edges: &[f64], key: impl Fn(&Beam) -> Option<f64>) -> Vec<BandStats> {
-    (0..edges.len())
-        .map(|k| {
-            let members: Vec<&Beam> = beams.iter().filter(|b| key(b).is_some_and(|v| band_of(edges, v) == k)).collect();
+/// Each band's statistics (KS left for the caller).
+fn band_stats(groups: &[Vec<&Beam>], edges: &[f64]) -> Vec<BandStats> {
+    groups
+        .iter()
+        .enumerate()
+        .map(|(k, members)| {
             let mut inl: Vec<f64> = members.iter().map(|b| b.residual).filter(|r| r.abs() <= OUTLIER_M).collect();
             let ranges: Vec<f64> = members.iter().filter(|b| b.residual.abs() <= OUTLIER_M).map(|b| b.sim).collect();
             let centre = median(&mut inl);

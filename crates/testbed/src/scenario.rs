@@ -490,10 +490,11 @@ fn resolve_robot(
 }
 
 fn resolve_lidar(cx: &Ctx, field: &str, r: &LidarRef) -> Result<LidarModel, ScenarioError> {
-    let preset = |name: &str| match name {
-        "hokuyo_urg_04lx" => Ok(LidarModel::hokuyo_urg_04lx()),
-        "rplidar_a1" => Ok(LidarModel::rplidar_a1()),
-        other => Err(cx.err(field, format!("unknown lidar preset `{other}` (expected hokuyo_urg_04lx or rplidar_a1)"))),
+    let preset = |name: &str| {
+        LidarModel::preset(name).ok_or_else(|| {
+            let names = LidarModel::PRESETS.join(" or ");
+            cx.err(field, format!("unknown lidar preset `{name}` (expected {names})"))
+        })
     };
     let lidar = match r {
         LidarRef::Preset(name) => preset(name)?,
