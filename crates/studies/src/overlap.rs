@@ -74,19 +74,17 @@ impl MapStyle {
         }
     }
 
-    /// `grid` in this style.
-    pub fn apply(self, grid: &OccupancyGrid) -> OccupancyGrid {
-        let mut g = grid.clone();
+    /// Puts `grid` in this style (in place).
+    pub fn apply(self, grid: &mut OccupancyGrid) {
         if self == MapStyle::Boundary {
-            for y in 0..g.height() {
-                for x in 0..g.width() {
-                    if g.state(x, y) == CellState::Occupied {
-                        g.set(x, y, 0.0);
+            for y in 0..grid.height() {
+                for x in 0..grid.width() {
+                    if grid.state(x, y) == CellState::Occupied {
+                        grid.set(x, y, 0.0);
                     }
                 }
             }
         }
-        g
     }
 }
 
@@ -165,7 +163,8 @@ pub fn run_overlap_study(study: &OverlapStudy, progress: &dyn Progress) -> Resul
 fn run_trial(study: &OverlapStudy, map: &OccupancyGrid, t: &TrialSpec) -> Vec<TrialRow> {
     let spec = PairSpec { overlap: t.overlap_target, max_shift_m: study.max_shift_m, rotate: true };
     let mut pair = cut_pair(map, &spec, t.seed);
-    (pair.a, pair.b) = (study.style.apply(&pair.a), study.style.apply(&pair.b));
+    study.style.apply(&mut pair.a);
+    study.style.apply(&mut pair.b);
     let max_translation_m = study.max_translation_cells * map.resolution();
     study
         .algorithms
@@ -210,10 +209,13 @@ mod tests {
                 .count()
         };
         assert!(cells(&plan, CellState::Occupied) > 100);
-        let b = MapStyle::Boundary.apply(&plan);
+        let mut b = plan.clone();
+        MapStyle::Boundary.apply(&mut b);
         assert_eq!(cells(&b, CellState::Occupied), 0);
         assert_eq!(cells(&b, CellState::Free), cells(&plan, CellState::Free));
-        assert_eq!(MapStyle::Walls.apply(&plan), plan);
+        let mut w = plan.clone();
+        MapStyle::Walls.apply(&mut w);
+        assert_eq!(w, plan);
     }
 
     fn small() -> OverlapStudy {
