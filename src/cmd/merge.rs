@@ -7,8 +7,8 @@ use mrslam_core::OccupancyGrid;
 use mrslam_core::map_io::{self, write_file_atomic};
 use mrslam_merge::MapImage;
 use mrslam_merge::{
-    Algorithm, CorrelativeMerger, CorrelativeParams, Evidence, FusionRule, MapEncoding, MatchParams, MergeParams,
-    MergeReport, Merger, Model, RmapMerger, RmapParams, SiftMerger, SiftMergerParams, merge,
+    Algorithm, BoundaryWalls, Cascade, CorrelativeMerger, CorrelativeParams, Evidence, FusionRule, MapEncoding,
+    MatchParams, MergeParams, MergeReport, Merger, Model, RmapMerger, RmapParams, SiftMerger, SiftMergerParams, merge,
 };
 use mrslam_testbed::runner::merge_view;
 use mrslam_viz::pair::record_pair;
@@ -32,9 +32,11 @@ pub struct MergeArgs {
     /// Write the merge report (JSON) here, accepted or not.
     #[arg(long)]
     pub report: Option<PathBuf>,
-    /// Merge algorithm: `sift` (the paper's, Alg. 3), `rmap` (Park's R-map baseline, Alg. 1) or `correlative`
-    /// (global correlative search by branch and bound).
-    #[arg(long, default_value = "sift", value_parser = algorithm_parser())]
+    /// Merge algorithm: `sift` (the paper's, Alg. 3), `rmap` (Park's R-map baseline, Alg. 1), `correlative`
+    /// (global correlative search by branch and bound) or `cascade` (`sift`, `sift` with every map's boundary as
+    /// walls, then `correlative`: the first answer the gate accepts; the default, chosen by measurement on
+    /// generated plans, cuts of a real map and two robots' SLAM maps: benchmarks/runs/2026-12-02-merge-cascade.md).
+    #[arg(long, default_value = "cascade", value_parser = algorithm_parser())]
     pub algorithm: Algorithm,
     /// Transform model: rigid, similarity or homography (the paper's; its rigid part is used).
     #[arg(long, default_value = "rigid")]
@@ -58,10 +60,11 @@ pub struct MergeArgs {
     /// (1: the 3x3 neighbourhood, the gate before 2026-12-02; 2 lets the walls of two robots' SLAM runs meet).
     #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u32).range(0..=4))]
     pub wall_tolerance: u32,
-    /// Take the maps as they are: no walls for a map that does not mark them (by default such a map, with almost
-    /// no occupied cells, gets walls where its free space meets unknown; the paper's merger has no such step).
-    #[arg(long)]
-    pub no_boundary_walls: bool,
+    /// Which maps get walls where their free space meets unknown: `unmarked` (maps with almost no occupied
+    /// cells: map_server's light-grey walls, glass), `always` (every map, its own walls kept) or `off` (the maps
+    /// as they are: the paper's merger has no such step; a cascade then skips its `sift+boundary` stage).
+    #[arg(long, default_value = "unmarked", value_parser = boundary_walls_parser())]
+    pub boundary_walls: BoundaryWalls,
     /// The correlative merger's significance test: its best pose must score this share above every pose clearly
     /// apart from it (Lowe's ratio test), else the merge is refused as ambiguous, naming the rival; 0 turns the
     /// test off [default: `CorrelativeParams::default().min_margin`, 0.15].
@@ -110,6 +113,11 @@ fn algorithm_parser() -> impl TypedValueParser<Value = Algorithm> {
     PossibleValuesParser::new(Algorithm::ALL.map(Algorithm::name)).try_map(|s| s.parse::<Algorithm>())
 }
 
+/// Reads `--boundary-walls`: a name of [`BoundaryWalls::ALL`].
+fn boundary_walls_parser() -> impl TypedValueParser<Value = BoundaryWalls> {
+    PossibleValuesParser::new(BoundaryWalls::ALL.map(BoundaryWalls::name)).try_map(|s| s.parse::<BoundaryWalls>())
+}
+
 /// Runs `mrslam merge`.
 pub fn run(args: MergeArgs) -> Result<ExitCode> {
     let kinds: [(&Option<PathBuf>, &str, &[&str]); 4] = [
@@ -148,6 +156,8 @@ pub fn run(args: MergeArgs) -> Result<ExitCode> {
         ..Default::default()
     };
     params.ransac.seed = args.seed;
+    let mut correlative = CorrelativeParams::default();
+    correlative.min_margin = args.min_margin.unwrap_or(correlative.min_margin);
     let merger: Box<dyn Merger> = match args.algorithm {
         Algorithm::Sift => Box::new(SiftMerger::new(params)),
         Algorithm::Rmap => {
@@ -155,16 +165,13 @@ pub fn run(args: MergeArgs) -> Result<ExitCode> {
             rp.orient.seed = args.seed;
             Box::new(RmapMerger::new(rp))
         }
-        Algorithm::Correlative => {
-            let mut cp = CorrelativeParams::default();
-            cp.min_margin = args.min_margin.unwrap_or(cp.min_margin);
-            Box::new(CorrelativeMerger::new(cp))
-        }
+        Algorithm::Correlative => Box::new(CorrelativeMerger::new(correlative)),
+        Algorithm::Cascade => Box::new(Cascade::new(params, correlative)),
     };
     let mut mp = MergeParams {
         verify_enabled: !args.no_verify,
         fusion: args.fusion,
-        boundary_walls: !args.no_boundary_walls,
+        boundary_walls: args.boundary_walls,
         ..MergeParams::default()
     };
     mp.verify.wall_tolerance_cells = args.wall_tolerance as usize;
@@ -206,11 +213,12 @@ fn pair_names(a: &Path, b: &Path) -> (String, String) {
 
 /// The human summary of a merge.
 pub fn summary(r: &MergeReport) -> String {
-    let mut s = format!(
-        "merge ({}): {}\n",
-        r.algorithm,
-        if r.accepted { "ACCEPTED".to_string() } else { "REJECTED".to_string() }
-    );
+    // A cascade names the stage that merged; a refusal's reason names every stage's.
+    let name = match (&r.stage, r.accepted) {
+        (Some(stage), true) => format!("{}: {stage}", r.algorithm),
+        _ => r.algorithm.clone(),
+    };
+    let mut s = format!("merge ({name}): {}\n", if r.accepted { "ACCEPTED" } else { "REJECTED" });
     if let Some(reason) = &r.reason {
         s += &format!("  reason:      {reason}\n");
     }
@@ -232,7 +240,13 @@ pub fn summary(r: &MergeReport) -> String {
         r.acceptance_index.map_or("-".to_string(), |v| format!("{v:.3}")),
         r.common_cells
     );
-    let stages: Vec<String> = r.timings_ms.iter().map(|(k, v)| format!("{k} {v:.1}")).collect();
+    // A cascade's stages in total (each stage's own breakdown is in the JSON report).
+    let stages: Vec<String> = r
+        .timings_ms
+        .iter()
+        .filter(|(k, _)| r.stage.is_none() || !k.contains('/'))
+        .map(|(k, v)| format!("{k} {v:.1}"))
+        .collect();
     s += &format!("  time:        {:.1} ms ({})\n", r.time_ms, stages.join(", "));
     s
 }

@@ -62,7 +62,7 @@ pub struct OverlapArgs {
     /// Trials per overlap.
     #[arg(long, default_value_t = 30)]
     pub trials: usize,
-    /// Algorithms, comma-separated (sift, rmap, correlative).
+    /// Algorithms, comma-separated (sift, rmap, correlative, cascade); the default compares the paper's two.
     #[arg(long, default_value = "sift,rmap", value_delimiter = ',')]
     pub algorithms: Vec<String>,
     /// Output folder: results.csv, summary.csv, plot.png.
@@ -155,8 +155,9 @@ pub struct LogsArgs {
     /// Set any SLAM parameter by its name (repeatable; after the preset), as `mrslam slam --set`.
     #[arg(long = "slam-set", value_name = "NAME=VALUE")]
     pub slam_set: Vec<String>,
-    /// Algorithms, comma-separated (sift, rmap, correlative).
-    #[arg(long, default_value = "sift,rmap", value_delimiter = ',')]
+    /// Algorithms, comma-separated (sift, rmap, correlative, cascade); the default compares the paper's merger
+    /// with `mrslam merge`'s.
+    #[arg(long, default_value = "sift,cascade", value_delimiter = ',')]
     pub algorithms: Vec<String>,
     /// The SIFT merger's map-to-image encoding: `walls` (free and unknown alike, the default) or `paper`
     /// (unknown grey, the paper's).

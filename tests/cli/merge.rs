@@ -40,7 +40,9 @@ fn cut_then_merge_recovers_the_printed_transform() {
         assert!(report.get(key).is_some(), "report lacks {key}: {report}");
     }
     assert!(report["time_ms"].as_f64().unwrap() > 0.0);
-    assert!(report["timings_ms"]["features"].as_f64().is_some());
+    // The default merger is the cascade; the paper's SIFT merger, its first stage, settles a clean cut.
+    assert_eq!((report["algorithm"].as_str(), report["stage"].as_str()), (Some("cascade"), Some("sift")));
+    assert!(report["timings_ms"]["sift/features"].as_f64().is_some());
     let t = &report["transform"];
     assert!((t["x"].as_f64().unwrap() - tx).abs() < 0.1, "{t} vs {truth:?}");
     assert!((t["y"].as_f64().unwrap() - ty).abs() < 0.1, "{t} vs {truth:?}");

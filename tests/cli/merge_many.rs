@@ -56,7 +56,7 @@ fn three_maps_are_placed_in_the_first_maps_frame() {
     let o = mrslam(&["merge", p(&a), p(&b), p(&c), "-o", p(&m), "--report", p(&r)]);
     let out = text(&o.stdout);
     assert_eq!(o.status.code(), Some(0), "{out}{}", text(&o.stderr));
-    assert!(out.contains("merge of 3 maps (sift): 3 of 3 in the frame of a.yaml"), "{out}");
+    assert!(out.contains("merge of 3 maps (cascade): 3 of 3 in the frame of a.yaml"), "{out}");
     assert!(out.contains("a.yaml + b.yaml: ACCEPTED"), "{out}");
     assert!(out.contains("tree") && out.contains(" -> "), "{out}");
     assert!(!out.contains("left out"), "{out}");

@@ -256,12 +256,12 @@ fn merge_records_both_maps_keypoints_matches_and_the_merged_map() {
     let o = mrslam(&["merge", p(&d.join("left.yaml")), p(&d.join("right.yaml")), "--rrd", p(&rrd)]);
     assert_eq!(o.status.code(), Some(0), "{}{}", text(&o.stdout), text(&o.stderr));
     let s = summarize(&rrd).unwrap();
-    assert_eq!(s.recordings, ["merge-left-right-sift-seed0"]);
-    for e in ["/maps/left", "/maps/right", "/merge/sift/keypoints/left", "/merge/sift/keypoints/right"] {
+    assert_eq!(s.recordings, ["merge-left-right-cascade-seed0"]);
+    for e in ["/maps/left", "/maps/right", "/merge/cascade/keypoints/left", "/merge/cascade/keypoints/right"] {
         assert_eq!(s.rows_at(e), 1, "{e}: {:?}", s.rows);
     }
-    assert_eq!(s.rows_at("/merge/sift/matches"), 1);
-    assert_eq!(s.rows_at("/merge/sift/merged"), 1, "the pair merges, so the merged map is there");
+    assert_eq!(s.rows_at("/merge/cascade/matches"), 1);
+    assert_eq!(s.rows_at("/merge/cascade/merged"), 1, "the pair merges, so the merged map is there");
     assert!(s.rows_at("/events") >= 1);
     assert_eq!(s.activations, 1);
     assert_eq!(s.footer_manifests.len(), 2, "a manifest for the recording and one for its blueprint: {s:?}");

@@ -10,7 +10,7 @@ use std::str::FromStr;
 /// let a: Algorithm = "rmap".parse().unwrap();
 /// assert_eq!(a, Algorithm::Rmap);
 /// assert_eq!(a.to_string(), "rmap");
-/// assert!("magic".parse::<Algorithm>().unwrap_err().to_string().contains("sift, rmap, correlative"));
+/// assert!("magic".parse::<Algorithm>().unwrap_err().to_string().contains("sift, rmap, correlative, cascade"));
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum Algorithm {
@@ -20,23 +20,27 @@ pub enum Algorithm {
     Rmap,
     /// `correlative`: global correlative search by branch and bound, [`crate::CorrelativeMerger`].
     Correlative,
+    /// `cascade`: `sift`, then `sift` with boundary walls, then `correlative`, the first the gate accepts,
+    /// [`crate::Cascade`].
+    Cascade,
 }
 
 impl Algorithm {
     /// Every algorithm, in the order they are listed and compared.
-    pub const ALL: [Algorithm; 3] = [Algorithm::Sift, Algorithm::Rmap, Algorithm::Correlative];
+    pub const ALL: [Algorithm; 4] = [Algorithm::Sift, Algorithm::Rmap, Algorithm::Correlative, Algorithm::Cascade];
 
-    /// The name (`sift`, `rmap`, `correlative`): what [`FromStr`] reads, [`Display`](fmt::Display) writes and
+    /// The name (`sift`, `rmap`, `correlative`, `cascade`): what [`FromStr`] reads, [`Display`](fmt::Display) writes and
     /// [`crate::Merger::name`] returns.
     pub const fn name(self) -> &'static str {
         match self {
             Algorithm::Sift => "sift",
             Algorithm::Rmap => "rmap",
             Algorithm::Correlative => "correlative",
+            Algorithm::Cascade => "cascade",
         }
     }
 
-    /// The names of [`Algorithm::ALL`], comma-separated: `sift, rmap, correlative`.
+    /// The names of [`Algorithm::ALL`], comma-separated: `sift, rmap, correlative, cascade`.
     pub fn names() -> String {
         Algorithm::ALL.map(Algorithm::name).join(", ")
     }
@@ -75,10 +79,10 @@ mod tests {
         for a in Algorithm::ALL {
             assert_eq!(a.to_string().parse::<Algorithm>(), Ok(a));
         }
-        assert_eq!(Algorithm::names(), "sift, rmap, correlative");
+        assert_eq!(Algorithm::names(), "sift, rmap, correlative, cascade");
         assert_eq!(
             "SIFT".parse::<Algorithm>().unwrap_err().to_string(),
-            "unknown algorithm `SIFT` (expected one of sift, rmap, correlative)"
+            "unknown algorithm `SIFT` (expected one of sift, rmap, correlative, cascade)"
         );
     }
 }

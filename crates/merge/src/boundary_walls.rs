@@ -7,6 +7,47 @@
 use mrslam_core::map_io::ROS_LOGODDS_LIMIT;
 use mrslam_core::{CellState, OccupancyGrid};
 
+/// Which maps get walls where their free space meets unknown.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum BoundaryWalls {
+    /// Maps as they are (the paper's merger).
+    Off,
+    /// Maps that do not mark their walls (fewer occupied cells than [`BOUNDARY_STYLE_RATIO`] of their boundary).
+    #[default]
+    Unmarked,
+    /// Every map, its own walls kept: the boundary of a map that marks only some of its walls completes them.
+    ///
+    /// A cut's edge and a robot's frontier are boundaries that are no walls, so this is a second try, not the
+    /// first ([`crate::Cascade`]): on willow-full-0.05 cuts at 3-5 % overlap it merges 14 and 15 of 15 pairs
+    /// against 2 and 7 as stored, on generated plans that mark every wall 8 of 20 at 20 % against 11.
+    Always,
+}
+
+impl BoundaryWalls {
+    /// Every mode, as the command line lists them.
+    pub const ALL: [BoundaryWalls; 3] = [BoundaryWalls::Off, BoundaryWalls::Unmarked, BoundaryWalls::Always];
+
+    /// The name: `off`, `unmarked` or `always`.
+    pub const fn name(self) -> &'static str {
+        match self {
+            BoundaryWalls::Off => "off",
+            BoundaryWalls::Unmarked => "unmarked",
+            BoundaryWalls::Always => "always",
+        }
+    }
+}
+
+impl std::str::FromStr for BoundaryWalls {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        BoundaryWalls::ALL
+            .into_iter()
+            .find(|m| m.name() == s)
+            .ok_or_else(|| format!("unknown boundary-walls mode `{s}` (expected off, unmarked or always)"))
+    }
+}
+
 /// A map with fewer occupied cells than this fraction of its free/unknown boundary cells does not mark its walls.
 /// Measured: a floor plan or FR079's SLAM maps have 0.5-0.9 occupied cells per boundary cell, ACES's SLAM maps only
 /// 0.03-0.11 (fans of long rays through its windows end in unknown space), a map with its walls dropped 0.
@@ -34,12 +75,29 @@ fn boundary_cells(grid: &OccupancyGrid) -> Vec<(usize, usize)> {
     out
 }
 
+/// Whether `grid` marks its walls: as many occupied cells as [`BOUNDARY_STYLE_RATIO`] of its free/unknown boundary
+/// cells (or no such boundary at all).
+pub fn marks_its_walls(grid: &OccupancyGrid) -> bool {
+    let boundary = boundary_cells(grid).len();
+    let (_, occupied, _) = grid.state_counts();
+    boundary == 0 || occupied as f64 >= BOUNDARY_STYLE_RATIO * boundary as f64
+}
+
 /// `grid` with walls where its free space meets unknown, when it does not mark its walls (fewer occupied cells than
 /// [`BOUNDARY_STYLE_RATIO`] of its boundary cells); `None` when it does (use it as it is).
 pub fn walls_from_boundary(grid: &OccupancyGrid) -> Option<OccupancyGrid> {
+    with_boundary_walls(grid, BoundaryWalls::Unmarked)
+}
+
+/// `grid` with walls where its free space meets unknown when `mode` asks for them; `None`: use it as it is.
+pub fn with_boundary_walls(grid: &OccupancyGrid, mode: BoundaryWalls) -> Option<OccupancyGrid> {
+    if mode == BoundaryWalls::Off {
+        return None;
+    }
     let boundary = boundary_cells(grid);
     let (_, occupied, _) = grid.state_counts();
-    if boundary.is_empty() || occupied as f64 >= BOUNDARY_STYLE_RATIO * boundary.len() as f64 {
+    let marked = occupied as f64 >= BOUNDARY_STYLE_RATIO * boundary.len() as f64;
+    if boundary.is_empty() || (mode == BoundaryWalls::Unmarked && marked) {
         return None;
     }
     let mut g = grid.clone();
@@ -106,7 +164,7 @@ mod tests {
         assert!(err.translation.vector.norm() < 0.1 && err.rotation.angle().abs() < 0.02, "{err:?}");
         let merged = out.merged.unwrap();
         assert_eq!(count(&merged, CellState::Occupied), 0, "the merged map is fused from the maps as given");
-        let off = MergeParams { boundary_walls: false, ..MergeParams::default() };
+        let off = MergeParams { boundary_walls: BoundaryWalls::Off, ..MergeParams::default() };
         assert!(!merge(&merger, &a, &b, &off).report.accepted, "the maps as they are have nothing to merge on");
     }
 

@@ -29,6 +29,7 @@
 
 mod algorithm;
 pub mod boundary_walls;
+mod cascade;
 mod correlative;
 mod estimate;
 pub mod floorplan;
@@ -46,6 +47,8 @@ mod sift_merger;
 mod verify;
 
 pub use algorithm::{Algorithm, UnknownAlgorithm};
+pub use boundary_walls::BoundaryWalls;
+pub use cascade::{Cascade, Stage};
 pub use correlative::{CorrelativeMerger, CorrelativeParams};
 pub use estimate::{Model, RansacParams};
 pub use fuse::FusionRule;

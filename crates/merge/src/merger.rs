@@ -1,5 +1,6 @@
 //! The merge pipeline shared by every algorithm: align, verify, fuse, report.
 
+use crate::boundary_walls::BoundaryWalls;
 use crate::fuse::{FusionRule, fuse};
 use crate::refine::{RefineParams, refine, wall_points};
 use crate::report::MergeReport;
@@ -80,6 +81,10 @@ pub trait Merger: Send + Sync {
     fn name(&self) -> &'static str;
     /// Estimates `T_a_b`, or says why it cannot.
     fn align(&self, a: &OccupancyGrid, b: &OccupancyGrid) -> Result<Alignment, Box<NoAlignment>>;
+    /// Its stages when it is a [`crate::Cascade`] ([`merge`] puts each stage's answer through the gate in turn).
+    fn cascade(&self) -> Option<&crate::Cascade> {
+        None
+    }
 }
 
 /// Parameters of the pipeline around an algorithm.
@@ -93,10 +98,10 @@ pub struct MergeParams {
     pub fusion: FusionRule,
     /// Wall ICP applied to the algorithm's transform before verification.
     pub refine: RefineParams,
-    /// Give a map that does not mark its walls (map_server's light-grey walls, glass) walls where its free space
-    /// meets unknown, for the alignment and the gate ([`crate::boundary_walls`]); false: maps as they are (the
-    /// paper's behaviour). The merged map is fused from the maps as given.
-    pub boundary_walls: bool,
+    /// Which maps get walls where their free space meets unknown, for the alignment and the gate
+    /// ([`crate::boundary_walls`]): by default those that do not mark their walls (map_server's light-grey walls,
+    /// glass); `Off` is the paper's behaviour. The merged map is fused from the maps as given.
+    pub boundary_walls: BoundaryWalls,
 }
 
 impl Default for MergeParams {
@@ -106,7 +111,7 @@ impl Default for MergeParams {
             verify_enabled: true,
             fusion: FusionRule::LogOddsSum,
             refine: RefineParams::default(),
-            boundary_walls: true,
+            boundary_walls: BoundaryWalls::Unmarked,
         }
     }
 }
@@ -229,13 +234,21 @@ fn pose_difference(t1: &Pose2, t2: &Pose2) -> (f64, f64) {
     (d.rotation.angle().to_degrees().abs(), d.translation.vector.norm())
 }
 
-/// Runs an algorithm, verifies its answer against both maps, and fuses them when it passes.
+/// Runs an algorithm, verifies its answer against both maps, and fuses them when it passes (a cascade: each of
+/// its stages in turn, until one passes).
 pub fn merge(merger: &dyn Merger, a: &OccupancyGrid, b: &OccupancyGrid, p: &MergeParams) -> MergeOutcome {
+    match merger.cascade() {
+        Some(c) => crate::cascade::merge_cascade(c, a, b, p),
+        None => merge_one(merger, a, b, p),
+    }
+}
+
+/// [`merge`] for one algorithm.
+pub(crate) fn merge_one(merger: &dyn Merger, a: &OccupancyGrid, b: &OccupancyGrid, p: &MergeParams) -> MergeOutcome {
     let start = Instant::now();
     // Maps that do not mark their walls get them from their free/unknown boundary; the fusion takes the maps as given.
     let (given_a, given_b) = (a, b);
-    let walled =
-        |g: &OccupancyGrid| if p.boundary_walls { crate::boundary_walls::walls_from_boundary(g) } else { None };
+    let walled = |g: &OccupancyGrid| crate::boundary_walls::with_boundary_walls(g, p.boundary_walls);
     let (walled_a, walled_b) = (walled(a), walled(b));
     let (a, b) = (walled_a.as_ref().unwrap_or(a), walled_b.as_ref().unwrap_or(b));
     let alignment = match merger.align(a, b) {
@@ -244,6 +257,7 @@ pub fn merge(merger: &dyn Merger, a: &OccupancyGrid, b: &OccupancyGrid, p: &Merg
             let report = MergeReport {
                 accepted: false,
                 algorithm: merger.name().to_string(),
+                stage: None,
                 transform: None,
                 scale: None,
                 matches: no.matches,
@@ -301,6 +315,7 @@ pub fn merge(merger: &dyn Merger, a: &OccupancyGrid, b: &OccupancyGrid, p: &Merg
     let report = MergeReport {
         accepted: reason.is_none(),
         algorithm: merger.name().to_string(),
+        stage: None,
         transform: Some(Xyt::from_pose(&alignment.transform)),
         scale: Some(alignment.scale),
         matches: alignment.matches,
@@ -318,12 +333,12 @@ pub fn merge(merger: &dyn Merger, a: &OccupancyGrid, b: &OccupancyGrid, p: &Merg
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use mrslam_core::pose;
 
     /// An algorithm that answers with fixed hypotheses.
-    struct Fixed(Vec<Pose2>);
+    pub(crate) struct Fixed(pub Vec<Pose2>);
 
     /// The same, its alternatives rivals only.
     struct FixedRivals(Vec<Pose2>);
@@ -359,7 +374,7 @@ mod tests {
     }
 
     /// A closed 4 m x 3 m room; with `stub`, a 3 m wall juts in from one side and breaks its symmetry.
-    fn room(stub: bool) -> OccupancyGrid {
+    pub(crate) fn room(stub: bool) -> OccupancyGrid {
         let (w, h) = (80, 60);
         let mut g = OccupancyGrid::new(w, h, 0.05, pose(0.0, 0.0, 0.0)).unwrap();
         for iy in 0..h {

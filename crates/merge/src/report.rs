@@ -10,6 +10,9 @@ pub struct MergeReport {
     pub accepted: bool,
     /// Algorithm name.
     pub algorithm: String,
+    /// The stage of a cascade that decided (the one accepted, else the last refusing); absent for one algorithm.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stage: Option<String>,
     /// Estimated `T_a_b`, when the algorithm produced one (also when rejected).
     pub transform: Option<Xyt>,
     /// Scale of the estimated model.

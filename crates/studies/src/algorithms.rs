@@ -1,12 +1,13 @@
 //! The merge algorithms a study compares, built for one trial.
 
 use mrslam_merge::{
-    Algorithm, CorrelativeMerger, MapEncoding, Merger, RmapMerger, RmapParams, SiftMerger, SiftMergerParams,
+    Algorithm, Cascade, CorrelativeMerger, CorrelativeParams, MapEncoding, Merger, RmapMerger, RmapParams, SiftMerger,
+    SiftMergerParams,
 };
 
 /// `algorithm`'s merger with default parameters for a map-level trial seeded `seed`.
 ///
-/// The correlative merger has no random draws. Only the SIFT merger's draws (its RANSAC) follow `seed`; the
+/// The correlative merger has no random draws. Only the SIFT merger's draws (also a cascade's) (its RANSAC) follow `seed`; the
 /// R-map merger's orientation draws keep their default seed ([`RmapParams::default`], 0) in every trial, as the published studies were computed. A
 /// simulated run ([`mrslam_testbed::runner::merger_for`]) seeds both with the scenario's seed.
 pub fn study_merger(algorithm: Algorithm, seed: u64) -> Box<dyn Merger> {
@@ -15,14 +16,13 @@ pub fn study_merger(algorithm: Algorithm, seed: u64) -> Box<dyn Merger> {
 
 /// [`study_merger`] with the SIFT merger's map-to-image encoding chosen (the other mergers have none).
 pub fn study_merger_encoded(algorithm: Algorithm, seed: u64, encoding: MapEncoding) -> Box<dyn Merger> {
+    let mut sift = SiftMergerParams { encoding, ..SiftMergerParams::default() };
+    sift.ransac.seed = seed;
     match algorithm {
-        Algorithm::Sift => {
-            let mut p = SiftMergerParams { encoding, ..SiftMergerParams::default() };
-            p.ransac.seed = seed;
-            Box::new(SiftMerger::new(p))
-        }
+        Algorithm::Sift => Box::new(SiftMerger::new(sift)),
         Algorithm::Rmap => Box::new(RmapMerger::new(RmapParams::default())),
         Algorithm::Correlative => Box::new(CorrelativeMerger::default()),
+        Algorithm::Cascade => Box::new(Cascade::new(sift, CorrelativeParams::default())),
     }
 }
 
@@ -60,7 +60,10 @@ mod tests {
     fn names_are_read_and_checked() {
         assert_eq!(parse_algorithms(&["sift", "rmap"]).unwrap(), [Algorithm::Sift, Algorithm::Rmap]);
         let err = |names: &[&str]| parse_algorithms(names).unwrap_err().to_string();
-        assert_eq!(err(&["sift", "magic"]), "unknown algorithm `magic` (expected one of sift, rmap, correlative)");
+        assert_eq!(
+            err(&["sift", "magic"]),
+            "unknown algorithm `magic` (expected one of sift, rmap, correlative, cascade)"
+        );
         assert_eq!(err(&["rmap", "rmap"]), "algorithm `rmap` given twice");
         assert_eq!(err(&[]), "no algorithms given");
     }

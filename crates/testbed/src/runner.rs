@@ -7,8 +7,8 @@ use crate::scenario::{ControllerKind, MergeWhen, RobotSetup, Scenario};
 use mrslam_core::map_io::{self, MapIoError};
 use mrslam_core::{CellTraversal, LaserScan, OccupancyGrid, Odometry, Pose2, Xyt};
 use mrslam_merge::{
-    Algorithm, CorrelativeMerger, MatchParams, MergeOutcome, MergeParams, Merger, RmapMerger, RmapParams, SiftMerger,
-    SiftMergerParams, merge,
+    Algorithm, Cascade, CorrelativeMerger, CorrelativeParams, MatchParams, MergeOutcome, MergeParams, Merger,
+    RmapMerger, RmapParams, SiftMerger, SiftMergerParams, merge,
 };
 use mrslam_sim::Obstacle;
 use mrslam_sim::{RobotId, Sim, SimConfig, SimError, StepEvents};
@@ -72,25 +72,24 @@ pub struct RunOutput {
 /// Builds `algorithm`'s merger with the scenario's merge settings, its random draws seeded by the scenario's seed.
 pub fn merger_for(algorithm: Algorithm, scenario: &Scenario) -> Box<dyn Merger> {
     let m = &scenario.merge;
+    let mut sift = SiftMergerParams {
+        model: m.model,
+        encoding: m.encoding,
+        matching: MatchParams { ratio: m.ratio, candidates: m.candidates, ..MatchParams::default() },
+        hypotheses: m.hypotheses,
+        wall_dilation: m.wall_dilation,
+        ..SiftMergerParams::default()
+    };
+    sift.ransac.seed = scenario.seed;
     match algorithm {
-        Algorithm::Sift => {
-            let mut p = SiftMergerParams {
-                model: m.model,
-                encoding: m.encoding,
-                matching: MatchParams { ratio: m.ratio, candidates: m.candidates, ..MatchParams::default() },
-                hypotheses: m.hypotheses,
-                wall_dilation: m.wall_dilation,
-                ..SiftMergerParams::default()
-            };
-            p.ransac.seed = scenario.seed;
-            Box::new(SiftMerger::new(p))
-        }
+        Algorithm::Sift => Box::new(SiftMerger::new(sift)),
         Algorithm::Rmap => {
             let mut p = RmapParams::default();
             p.orient.seed = scenario.seed;
             Box::new(RmapMerger::new(p))
         }
         Algorithm::Correlative => Box::new(CorrelativeMerger::default()),
+        Algorithm::Cascade => Box::new(Cascade::new(sift, CorrelativeParams::default())),
     }
 }
 

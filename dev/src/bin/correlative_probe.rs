@@ -212,7 +212,23 @@ fn main() {
         };
         let plan_seed = mix(mix(1 ^ 0xf100_4b1a_0000_0000) ^ (rep % 8));
         let map = generate(plan_seed, &FloorplanParams { width_m: v[0], height_m: v[1], ..FloorplanParams::default() });
-        let pair = cut_pair(&map, &PairSpec { overlap: v[2], max_shift_m: 5.0, rotate: true }, seed);
+        let mut pair = cut_pair(&map, &PairSpec { overlap: v[2], max_shift_m: 5.0, rotate: true }, seed);
+        if std::env::var_os("BOUNDARY").is_some() {
+            // `--map-style boundary`: every occupied cell dropped to unknown after the cut.
+            for g in [&mut pair.a, &mut pair.b] {
+                for y in 0..g.height() {
+                    for x in 0..g.width() {
+                        if g.state(x, y) == mrslam_core::CellState::Occupied {
+                            g.set(x, y, 0.0);
+                        }
+                    }
+                }
+                // The walls the merge pipeline gives such a map, so the probe sees what the merger sees.
+                if let Some(walled) = mrslam_merge::boundary_walls::walls_from_boundary(g) {
+                    *g = walled;
+                }
+            }
+        }
         if let Ok(dir) = std::env::var("WRITE") {
             // The pair as map files, and its truth, for the file mode.
             let dir = std::path::Path::new(&dir);

@@ -9,7 +9,7 @@
 //! for each rotation, step = cell / radius (rayon):     (Olson 2009; Cartographer's angular step)
 //!     branch and bound over all translations           search::branch_and_bound
 //! best distinct (rotation, translation) overall        hypotheses, strongest first, and rivals
-//! each: exhaustive window at a's resolution            local::local_search
+//! each: a window at a's resolution (branch and bound)   local::local_search
 //! the strongest: wall ICP, scored again, ranked        refine::refine
 //! significance: best against the best 2 m or more away Significance (Lowe's ratio test)
 //! not settled: a second search with a softer penalty   fallback_free_penalty, answers pooled
@@ -27,6 +27,7 @@
 
 pub mod field;
 pub mod local;
+pub mod orientation;
 pub mod pyramid;
 pub mod scan;
 pub mod search;
@@ -84,6 +85,14 @@ pub struct CorrelativeParams {
     /// 18 m plans cut apart (nothing shared), 180° flips laid wall on wall over 23-36 m² (acceptance 0.95-0.99)
     /// with a margin of 0.13-0.29; ACES's true poses share 270-280 m².
     pub fallback_min_overlap_m2: f64,
+    /// Search only the rotations near the peaks of the correlation of the maps' wall-orientation histograms
+    /// ([`orientation`], after Carpin 2008's Hough spectra); false: every rotation (the search as Hess et al.
+    /// describe it).
+    pub rotation_prior: bool,
+    /// The peaks kept: local maxima scoring at least this share of the highest.
+    pub rotation_peak_ratio: f64,
+    /// Rotations within this many degrees of a peak (or of it plus a half turn) are searched.
+    pub rotation_tolerance_deg: f64,
     /// Levels of the max-pooled pyramid: root blocks of the branch and bound are `2^depth` cells a side.
     pub depth: usize,
     /// Angular step as a multiple of Cartographer's `cell / radius of b's walls` (1: a point at the far
@@ -164,6 +173,9 @@ impl Default for CorrelativeParams {
             fine_free_penalty: 2.0,
             fallback_free_penalty: 1.0,
             fallback_min_overlap_m2: 100.0,
+            rotation_prior: true,
+            rotation_peak_ratio: 0.3,
+            rotation_tolerance_deg: 4.0,
             depth: 6,
             angle_step_scale: 1.0,
             max_points: 800,
@@ -200,6 +212,10 @@ impl CorrelativeMerger {
         CorrelativeMerger { params }
     }
 }
+
+/// Levels of the fine field's max-pooled pyramid: its windows (a search cell and one more either side, 19 cells
+/// at 0.4 m over 5 cm) start as 8-cell blocks.
+const FINE_DEPTH: usize = 3;
 
 /// The rounds of the rotation search, as (modulus, remainder) of the rotation index: every 16th first.
 const ROUNDS: [(usize, usize); 5] = [(16, 0), (16, 8), (8, 4), (4, 2), (2, 1)];
@@ -262,12 +278,15 @@ impl Significance {
             return None;
         }
         let (x, y, deg) = (self.best.translation.x, self.best.translation.y, self.best.rotation.angle().to_degrees());
-        let Some(r) = &self.rival else {
+        if self.best_score <= 0 {
             return Some(format!(
-                "no pose scores above 0: the best (x {x:.2} m, y {y:.2} m, {deg:.1} deg) scores {}",
+                "no pose scores above 0 (b's walls fall on a's free space more than on its walls): the best (x {x:.2} \
+                 m, y {y:.2} m, {deg:.1} deg) scores {}",
                 self.best_score
             ));
-        };
+        }
+        // A positive best without a rival leads by 100 %: never refused.
+        let r = self.rival.as_ref()?;
         let d = self.best.inverse() * r;
         Some(format!(
             "ambiguous: the best pose (x {x:.2} m, y {y:.2} m, {deg:.1} deg) scores {}, a pose {:.0} deg and {:.1} m \
@@ -324,7 +343,7 @@ pub fn score_near(
     let window = LocalWindow { cells: 2, angles: 2, angle_step: step };
     let start = to_scan_pose(a, &scan.centroid, t_a_b);
     let mut pts = Vec::new();
-    let (q, s) = local_search(&grid.levels[0], cell, &scan, start, &window, &mut pts);
+    let (q, s) = local_search(&grid, cell, &scan, start, &window, &mut pts);
     scan.discretize(q.theta, cell, &mut pts);
     let (cx, cy) = ((q.tx / cell - 0.5).round() as i32, (q.ty / cell - 0.5).round() as i32);
     let mut counts = [0usize; 3];
@@ -406,6 +425,12 @@ impl CorrelativeMerger {
         let step = (p.angle_step_scale * cell / scan.radius.max(cell)).min(PI / 2.0);
         let n_rot = (TAU / step).ceil() as usize;
         let step = TAU / n_rot as f64;
+        let t_prior = Instant::now();
+        let peaks =
+            if p.rotation_prior { orientation::rotation_peaks(a, b, p.rotation_peak_ratio) } else { Vec::new() };
+        let tolerance = p.rotation_tolerance_deg.to_radians().max(step);
+        let searched = |j: usize| peaks.is_empty() || orientation::near_a_peak(j as f64 * step, &peaks, tolerance);
+        timings.insert("orientation".into(), ms(t_prior));
         let min_floor = (p.min_score * f64::from(HIT) * scan.points.len() as f64).ceil() as i64;
         let separation = ((p.distinct_m / cell).ceil() as i32).max(1);
         let one = |scratch: &mut (Vec<(i32, i32)>, Vec<Candidate>), j: usize, floor: i64| -> Vec<Global> {
@@ -426,7 +451,7 @@ impl CorrelativeMerger {
         let mut all: Vec<Global> = Vec::new();
         let mut floor = min_floor;
         for (modulus, rest) in ROUNDS {
-            let js: Vec<usize> = (0..n_rot).filter(|j| j % modulus == rest).collect();
+            let js: Vec<usize> = (0..n_rot).filter(|&j| j % modulus == rest && searched(j)).collect();
             let found: Vec<Vec<Global>> = if p.parallel {
                 js.par_iter().map_init(|| (Vec::new(), Vec::new()), |s, &j| one(s, j, floor)).collect()
             } else {
@@ -507,26 +532,28 @@ impl CorrelativeMerger {
             p.fine_sigma_cells,
             (p.fine_free_penalty.max(0.0) * f64::from(HIT)).round() as i16,
         );
-        let fine = Pyramid::build(&fine, 0);
+        let fine = Pyramid::build(&fine, FINE_DEPTH);
         let coarse_cells = ((p.search_resolution / a.resolution()).round() as i32).max(1);
         let window = LocalWindow {
             cells: coarse_cells + 1,
             angles: p.fine_angles,
             angle_step: searches.iter().map(|f| f.step).fold(f64::INFINITY, f64::min) / p.fine_angles.max(1) as f64,
         };
-        let mut buf = Vec::new();
-        let mut one = |t_a_b: &Pose2| {
+        let one = |buf: &mut Vec<(i32, i32)>, (i, t_a_b): (usize, &Pose2)| {
             let start = to_scan_pose(a, &scan.centroid, t_a_b);
-            local_search(&fine.levels[0], a.resolution(), &scan, start, &window, &mut buf)
+            let (q, s) = local_search(&fine, a.resolution(), &scan, start, &window, buf);
+            (i, q, s)
         };
         // Every global answer and rival refined: the fine field ranks them (the coarse search only screens).
-        let mut refined: Vec<(usize, ScanPose, i64)> = searches
-            .iter()
-            .flat_map(|f| f.poses.iter().chain(&f.rivals))
-            .enumerate()
-            .map(|(i, t)| (i, one(t)))
-            .map(|(i, (q, s))| (i, q, s))
-            .collect();
+        let starts: Vec<(usize, &Pose2)> =
+            searches.iter().flat_map(|f| f.poses.iter().chain(&f.rivals)).enumerate().collect();
+        let mut refined: Vec<(usize, ScanPose, i64)> = if p.parallel {
+            starts.par_iter().map_init(Vec::new, |buf, &s| one(buf, s)).collect()
+        } else {
+            let mut buf = Vec::new();
+            starts.iter().map(|&s| one(&mut buf, s)).collect()
+        };
+        let mut buf = Vec::new();
         refined.sort_by(|x, y| y.2.cmp(&x.2).then(x.0.cmp(&y.0)));
         let apart =
             |q: &ScanPose, k: &ScanPose| (q.tx - k.tx).hypot(q.ty - k.ty) + scan.radius * angle_gap(q.theta, k.theta);
@@ -547,14 +574,8 @@ impl CorrelativeMerger {
             .take(p.polished.max(1))
             .map(|(i, q, _)| {
                 let t = refine(a, &fine_points, &transform(q), &icp);
-                let (_, s) = local_search(
-                    &fine.levels[0],
-                    a.resolution(),
-                    &scan,
-                    to_scan_pose(a, &scan.centroid, &t),
-                    &window0,
-                    &mut buf,
-                );
+                let (_, s) =
+                    local_search(&fine, a.resolution(), &scan, to_scan_pose(a, &scan.centroid, &t), &window0, &mut buf);
                 (*i, t, s)
             })
             .collect();
@@ -677,7 +698,7 @@ impl CorrelativeMerger {
             .enumerate()
             .map(|(i, t_a_b)| {
                 let start = to_scan_pose(a, &scan.centroid, t_a_b);
-                let (q, s) = local_search(&field.levels[0], cell, &scan, start, &window, &mut buf);
+                let (q, s) = local_search(&field, cell, &scan, start, &window, &mut buf);
                 (i, q, s)
             })
             .collect();

@@ -1,0 +1,285 @@
+//! Mergers tried in turn, each answer through the verification gate: the fast answer first, the slow search only
+//! for the pairs it could not settle.
+//!
+//! ```text
+//! sift            the paper's merger on the maps (walls from the boundary of a map that marks none)
+//! sift+boundary   the same with every map's free/unknown boundary as walls (maps that mark only some walls)
+//! correlative     the global search (two robots' maps: doubled walls, doors, people; few shared features)
+//! ```
+//!
+//! The first answer the gate accepts is the merge; a pair every stage refuses is refused with each stage's reason.
+//! Each stage is a second chance for a wrong pose too, so the order and the stages were chosen by measuring false
+//! merges on non-overlapping pairs alongside the successes (benchmarks/runs/2026-12-02-merge-cascade.md).
+
+use crate::boundary_walls::{BoundaryWalls, marks_its_walls};
+use crate::merger::{Alignment, MergeOutcome, MergeParams, Merger, NoAlignment, merge_one};
+use crate::{CorrelativeMerger, CorrelativeParams, SiftMerger, SiftMergerParams};
+use mrslam_core::OccupancyGrid;
+use std::collections::BTreeMap;
+use std::time::Instant;
+
+/// One stage of a [`Cascade`].
+pub struct Stage {
+    /// Its name in reports and timings (`sift`, `sift+boundary`, `correlative`).
+    pub name: &'static str,
+    /// The algorithm.
+    pub merger: Box<dyn Merger>,
+    /// Walls from the maps' boundaries for this stage instead of [`MergeParams::boundary_walls`]; such a stage
+    /// runs only when the pipeline's mode is the default ([`BoundaryWalls::Unmarked`]): `Off` asks for the maps as
+    /// they are, and `Always` already gave the first stage those walls. With `Always`, it is also skipped when
+    /// neither map marks its walls: the first stage saw the same walls.
+    pub boundary_walls: Option<BoundaryWalls>,
+    /// Run only when both maps mark their walls ([`crate::boundary_walls::marks_its_walls`]).
+    ///
+    /// The correlative search scores a wall of b on a's free space against the pose, and a boundary is a frontier
+    /// as often as a wall: on a generated plan cut at 20 % overlap with its walls dropped, b's frontier lay on a's
+    /// free space at the true pose, which scored 2088 against a 180° flip's 39767, and the flip (12 m off) passed
+    /// the gate.
+    pub needs_marked_walls: bool,
+}
+
+/// Mergers tried in turn through the gate; the first accepted answer is the merge (`--algorithm cascade`).
+pub struct Cascade {
+    /// The stages, in the order they are tried.
+    pub stages: Vec<Stage>,
+}
+
+impl Cascade {
+    /// `sift`, `sift+boundary`, `correlative`, with these parameters.
+    pub fn new(sift: SiftMergerParams, correlative: CorrelativeParams) -> Self {
+        Cascade {
+            stages: vec![
+                Stage {
+                    name: "sift",
+                    merger: Box::new(SiftMerger::new(sift.clone())),
+                    boundary_walls: None,
+                    needs_marked_walls: false,
+                },
+                Stage {
+                    name: "sift+boundary",
+                    merger: Box::new(SiftMerger::new(sift)),
+                    boundary_walls: Some(BoundaryWalls::Always),
+                    needs_marked_walls: false,
+                },
+                Stage {
+                    name: "correlative",
+                    merger: Box::new(CorrelativeMerger::new(correlative)),
+                    boundary_walls: None,
+                    needs_marked_walls: true,
+                },
+            ],
+        }
+    }
+
+    /// The stages that run on maps that mark their walls or not (`marked`: both do, `some_marked`: one does)
+    /// under the pipeline's parameters, each with the parameters it runs with.
+    fn active(&self, p: &MergeParams, marked: bool, some_marked: bool) -> impl Iterator<Item = (&Stage, MergeParams)> {
+        self.stages.iter().filter(move |s| marked || !s.needs_marked_walls).filter_map(move |s| {
+            match s.boundary_walls {
+                None => Some((s, *p)),
+                Some(BoundaryWalls::Always) if !some_marked => None,
+                Some(mode) if p.boundary_walls == BoundaryWalls::Unmarked => {
+                    Some((s, MergeParams { boundary_walls: mode, ..*p }))
+                }
+                Some(_) => None,
+            }
+        })
+    }
+}
+
+impl Default for Cascade {
+    fn default() -> Self {
+        Cascade::new(SiftMergerParams::default(), CorrelativeParams::default())
+    }
+}
+
+impl Merger for Cascade {
+    fn name(&self) -> &'static str {
+        crate::Algorithm::Cascade.name()
+    }
+
+    /// Without the gate there is nothing to decide between stages: the first stage's answer that has one.
+    fn align(&self, a: &OccupancyGrid, b: &OccupancyGrid) -> Result<Alignment, Box<NoAlignment>> {
+        let mut last = None;
+        for stage in &self.stages {
+            match stage.merger.align(a, b) {
+                Ok(al) => return Ok(al),
+                Err(no) => last = Some(no),
+            }
+        }
+        Err(last.unwrap_or_else(no_stages))
+    }
+
+    fn cascade(&self) -> Option<&Cascade> {
+        Some(self)
+    }
+}
+
+/// Runs the cascade's stages in turn through [`merge_one`]; the first accepted outcome, else the last refusal
+/// with every stage's reason. Timings are prefixed by the stage (`correlative/search`), the report's `stage`
+/// names the stage that decided.
+pub(crate) fn merge_cascade(c: &Cascade, a: &OccupancyGrid, b: &OccupancyGrid, p: &MergeParams) -> MergeOutcome {
+    let start = Instant::now();
+    let mut timings = BTreeMap::new();
+    let mut reasons = Vec::new();
+    let mut last: Option<MergeOutcome> = None;
+    let (marks_a, marks_b) = (marks_its_walls(a), marks_its_walls(b));
+    for (stage, params) in c.active(p, marks_a && marks_b, marks_a || marks_b) {
+        let mut out = merge_one(stage.merger.as_ref(), a, b, &params);
+        for (k, v) in std::mem::take(&mut out.report.timings_ms) {
+            timings.insert(format!("{}/{k}", stage.name), v);
+        }
+        timings.insert(stage.name.to_string(), out.report.time_ms);
+        out.report.stage = Some(stage.name.to_string());
+        if out.report.accepted {
+            last = Some(out);
+            break;
+        }
+        reasons.push(format!("{}: {}", stage.name, out.report.reason.as_deref().unwrap_or("refused")));
+        last = Some(out);
+    }
+    let Some(mut out) = last else {
+        return merge_one(&NoStages, a, b, p);
+    };
+    if !out.report.accepted {
+        out.report.reason = Some(reasons.join("; "));
+    }
+    out.report.algorithm = c.name().to_string();
+    out.report.timings_ms = timings;
+    out.report.time_ms = start.elapsed().as_secs_f64() * 1e3;
+    out
+}
+
+/// What an empty cascade aligns with: nothing.
+struct NoStages;
+
+/// Why an empty cascade finds nothing.
+fn no_stages() -> Box<NoAlignment> {
+    Box::new(NoAlignment {
+        reason: "a cascade without stages".into(),
+        matches: 0,
+        timings_ms: BTreeMap::new(),
+        evidence: Default::default(),
+    })
+}
+
+impl Merger for NoStages {
+    fn name(&self) -> &'static str {
+        crate::Algorithm::Cascade.name()
+    }
+    fn align(&self, _: &OccupancyGrid, _: &OccupancyGrid) -> Result<Alignment, Box<NoAlignment>> {
+        Err(no_stages())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::merger::tests::{Fixed, room};
+    use mrslam_core::{Pose2, pose};
+
+    /// A cascade of fixed answers: (stage name, its answer, its boundary-walls override).
+    fn cascade(stages: &[(&'static str, Pose2, Option<BoundaryWalls>)]) -> Cascade {
+        let stage = |&(name, t, boundary_walls): &(&'static str, Pose2, Option<BoundaryWalls>)| Stage {
+            name,
+            merger: Box::new(Fixed(vec![t])),
+            boundary_walls,
+            needs_marked_walls: false,
+        };
+        Cascade { stages: stages.iter().map(stage).collect() }
+    }
+
+    /// The room with its walls dropped to unknown: a map that does not mark its walls.
+    fn bare_room() -> OccupancyGrid {
+        let mut g = room(true);
+        for y in 0..g.height() {
+            for x in 0..g.width() {
+                if g.state(x, y) == mrslam_core::CellState::Occupied {
+                    g.set(x, y, 0.0);
+                }
+            }
+        }
+        g
+    }
+
+    #[test]
+    fn stages_that_would_see_nothing_new_or_need_marked_walls_are_skipped() {
+        let (g, bare) = (room(true), bare_room());
+        assert!(marks_its_walls(&g) && !marks_its_walls(&bare));
+        let off = pose(1.0, 0.0, 0.0);
+        let mut c =
+            cascade(&[("first", off, None), ("boundary", off, Some(BoundaryWalls::Always)), ("marked", off, None)]);
+        c.stages[2].needs_marked_walls = true;
+        let ran = |a: &OccupancyGrid, b: &OccupancyGrid| -> Vec<&str> {
+            let reason = crate::merge(&c, a, b, &MergeParams::default()).report.reason.unwrap();
+            ["first", "boundary", "marked"].into_iter().filter(|n| reason.contains(&format!("{n}: "))).collect()
+        };
+        assert_eq!(ran(&g, &g), ["first", "boundary", "marked"]);
+        // Neither map marks its walls: the first stage already had them from the boundary.
+        assert_eq!(ran(&bare, &bare), ["first"]);
+        // One does: its boundary adds walls the first stage did not see; the correlative-like stage still waits.
+        assert_eq!(ran(&g, &bare), ["first", "boundary"]);
+    }
+
+    #[test]
+    fn the_first_stage_the_gate_accepts_is_the_merge() {
+        let g = room(true);
+        let off = pose(1.0, 0.0, 0.0);
+        let c = cascade(&[("first", off, None), ("second", Pose2::identity(), None), ("third", off, None)]);
+        let unchecked = MergeParams { verify_enabled: false, ..MergeParams::default() };
+        assert_eq!(crate::merge(&c, &g, &g, &unchecked).report.stage.as_deref(), Some("first"), "no gate: the first");
+        let out = crate::merge(&c, &g, &g, &MergeParams::default());
+        assert!(out.report.accepted, "{:?}", out.report.reason);
+        assert_eq!(out.report.algorithm, "cascade");
+        assert_eq!(out.report.stage.as_deref(), Some("second"));
+        let t = out.report.transform.unwrap();
+        assert!(t.x.abs() < 0.05 && t.y.abs() < 0.05, "{t:?}");
+        assert!(out.merged.is_some());
+        // Each stage run is timed under its name; the third never ran.
+        assert!(out.report.timings_ms.contains_key("first") && out.report.timings_ms.contains_key("second"));
+        assert!(out.report.timings_ms.keys().any(|k| k.starts_with("second/")));
+        assert!(!out.report.timings_ms.contains_key("third"));
+    }
+
+    #[test]
+    fn a_pair_every_stage_refuses_is_refused_with_each_reason() {
+        let g = room(true);
+        let (x, y) = (pose(1.0, 0.0, 0.0), pose(0.0, 1.0, 0.0));
+        let c = cascade(&[("first", x, None), ("second", y, Some(BoundaryWalls::Always))]);
+        let out = crate::merge(&c, &g, &g, &MergeParams::default());
+        assert!(!out.report.accepted && out.merged.is_none());
+        let reason = out.report.reason.unwrap();
+        assert!(reason.starts_with("first: ") && reason.contains("; second: "), "{reason}");
+        assert_eq!(out.report.stage.as_deref(), Some("second"), "the last refusal is reported");
+        // With the maps taken as they are, a stage that would give them walls does not run.
+        let as_they_are = MergeParams { boundary_walls: BoundaryWalls::Off, ..MergeParams::default() };
+        let reason = crate::merge(&c, &g, &g, &as_they_are).report.reason.unwrap();
+        assert!(reason.starts_with("first: ") && !reason.contains("second"), "{reason}");
+    }
+
+    #[test]
+    fn pairs_the_papers_merger_refuses_are_merged_by_the_correlative_stage() {
+        use crate::floorplan::{FloorplanParams, generate};
+        use crate::pairs::{PairSpec, cut_pair};
+        for seed in [1, 3, 7] {
+            let plan = generate(seed, &FloorplanParams { width_m: 18.0, height_m: 14.0, ..FloorplanParams::default() });
+            let pair = cut_pair(&plan, &PairSpec { overlap: 0.15, max_shift_m: 3.0, rotate: true }, seed);
+            let paper = crate::merge(&crate::SiftMerger::default(), &pair.a, &pair.b, &MergeParams::default());
+            assert!(!paper.report.accepted, "seed {seed}: sift merges it");
+            let out = crate::merge(&Cascade::default(), &pair.a, &pair.b, &MergeParams::default());
+            assert!(out.report.accepted, "seed {seed}: {:?}", out.report.reason);
+            assert_eq!(out.report.stage.as_deref(), Some("correlative"));
+            let err = out.report.transform.unwrap().to_pose().inverse() * pair.t_a_b;
+            assert!(
+                err.translation.vector.norm() < 0.05 && err.rotation.angle().abs() < 0.2f64.to_radians(),
+                "{err:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn the_default_cascade_names_its_stages_in_order() {
+        let names: Vec<_> = Cascade::default().stages.iter().map(|s| s.name).collect();
+        assert_eq!(names, ["sift", "sift+boundary", "correlative"]);
+    }
+}
