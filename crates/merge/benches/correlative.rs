@@ -1,11 +1,13 @@
 //! The correlative merger on the 600×600 pair of the SIFT benchmark (`merge.rs`): the whole `merge` pipeline
-//! with the rotation search on rayon's threads and on one thread, and the global search alone.
+//! with the rotation search on rayon's threads and on one thread, and the global search alone; the default
+//! cascade on a pair the SIFT merger refuses (every stage runs, the correlative one merges), and the correlative
+//! search with every rotation (no orientation prior) on the same pair.
 #![allow(missing_docs, reason = "criterion_group! defines an undocumented public function")]
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use mrslam_merge::floorplan::{FloorplanParams, generate};
 use mrslam_merge::pairs::{PairSpec, cut_pair};
-use mrslam_merge::{CorrelativeMerger, CorrelativeParams, MergeParams, Merger, merge};
+use mrslam_merge::{Cascade, CorrelativeMerger, CorrelativeParams, MergeParams, Merger, merge};
 use std::hint::black_box;
 
 fn bench_correlative(c: &mut Criterion) {
@@ -29,6 +31,26 @@ fn bench_correlative(c: &mut Criterion) {
         b.iter(|| merge(&single, black_box(&pair.a), black_box(&pair.b), &params))
     });
     g.bench_function("align_one_thread", |b| b.iter(|| single.align(black_box(&pair.a), black_box(&pair.b))));
+    g.finish();
+
+    // An 18 m × 14 m plan cut at 15 % overlap (the cascade's unit test, seed 1): SIFT refuses it.
+    let plan = FloorplanParams { width_m: 18.0, height_m: 14.0, ..FloorplanParams::default() };
+    let pair = cut_pair(&generate(1, &plan), &PairSpec { overlap: 0.15, max_shift_m: 3.0, rotate: true }, 1);
+    let cascade = Cascade::default();
+    let out = merge(&cascade, &pair.a, &pair.b, &params);
+    eprintln!(
+        "cascade: accepted {} by {:?}, stages (ms): {:?}",
+        out.report.accepted, out.report.stage, out.report.timings_ms
+    );
+    assert!(out.report.accepted && out.report.stage.as_deref() == Some("correlative"), "{:?}", out.report.reason);
+    let every_rotation =
+        CorrelativeMerger::new(CorrelativeParams { rotation_prior: false, ..CorrelativeParams::default() });
+    let mut g = c.benchmark_group("cascade_18x14_low_overlap");
+    g.bench_function("cascade", |b| b.iter(|| merge(&cascade, black_box(&pair.a), black_box(&pair.b), &params)));
+    g.bench_function("correlative", |b| b.iter(|| merge(&parallel, black_box(&pair.a), black_box(&pair.b), &params)));
+    g.bench_function("correlative_every_rotation", |b| {
+        b.iter(|| merge(&every_rotation, black_box(&pair.a), black_box(&pair.b), &params))
+    });
     g.finish();
 }
 

@@ -1,15 +1,18 @@
 //! A global correlative merger: the whole of map b's walls matched against a likelihood field of map a's
-//! over every rotation and translation, as Cartographer's loop closure searches a whole submap.
+//! over every translation and the rotations the walls' orientations allow, as Cartographer's loop closure searches
+//! a whole submap.
 //!
 //! ```text
 //! pool a and b to search cells (search_resolution)     field::BlockStates
 //! score field of a: blurred walls, penalised free      field::ScoreField
 //! max-pooled pyramid of the field                      pyramid::Pyramid (Hess et al. 2016)
 //! b's wall blocks as points about their centroid       scan::WallScan
-//! for each rotation, step = cell / radius (rayon):     (Olson 2009; Cartographer's angular step)
+//! rotations near the peaks of the wall-orientation     orientation (Carpin 2008's Hough-spectrum idea)
+//!     correlation of a and b (± 4°, θ and θ + π)
+//! for each such rotation, step = cell / radius (rayon): (Olson 2009; Cartographer's angular step)
 //!     branch and bound over all translations           search::branch_and_bound
 //! best distinct (rotation, translation) overall        hypotheses, strongest first, and rivals
-//! each: a window at a's resolution (branch and bound)   local::local_search
+//! each: a window at a's resolution (branch and bound; rayon) local::local_search
 //! the strongest: wall ICP, scored again, ranked        refine::refine
 //! significance: best against the best 2 m or more away Significance (Lowe's ratio test)
 //! not settled: a second search with a softer penalty   fallback_free_penalty, answers pooled
