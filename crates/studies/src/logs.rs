@@ -342,6 +342,8 @@ pub struct PairRow {
     pub common_cells: usize,
     /// Share of b's walls meeting a's walls.
     pub wall_agreement: Option<f64>,
+    /// The stage of a cascade that decided (empty for one algorithm).
+    pub stage: String,
     /// Why the merge was refused (empty when accepted).
     pub reason: String,
 }
@@ -350,7 +352,7 @@ pub struct PairRow {
 pub const RESULTS_HEADER: &str = "part_i,part_j,algorithm,relations,overlap,overlap_smaller,truth_x,truth_y,\
 truth_theta_deg,truth_error_m,truth_error_deg,accepted,success,false_merge,estimate_x,estimate_y,\
 estimate_theta_deg,error_m,error_deg,error_to_truth_m,error_to_truth_deg,time_ms,matches,inliers,confidence,\
-acceptance_index,common_cells,wall_agreement,reason";
+acceptance_index,common_cells,wall_agreement,stage,reason";
 
 fn opt(v: Option<f64>) -> String {
     v.map_or(String::new(), |x| format!("{x:.6}"))
@@ -366,7 +368,7 @@ impl PairRow {
     pub fn to_csv(&self) -> String {
         let (tx, ty, tt) = self.truth;
         format!(
-            "{},{},{},{},{:.6},{:.6},{tx:.6},{ty:.6},{tt:.6},{:.6},{:.6},{},{},{},{},{},{},{},{},{},{},{:.3},{},{},{:.6},{},{},{},{}",
+            "{},{},{},{},{:.6},{:.6},{tx:.6},{ty:.6},{tt:.6},{:.6},{:.6},{},{},{},{},{},{},{},{},{},{},{:.3},{},{},{:.6},{},{},{},{},{}",
             self.part_i,
             self.part_j,
             self.algorithm,
@@ -392,6 +394,7 @@ impl PairRow {
             opt(self.acceptance_index),
             self.common_cells,
             opt(self.wall_agreement),
+            self.stage,
             csv_field(&self.reason),
         )
     }
@@ -462,6 +465,7 @@ pub fn merge_pair(
         acceptance_index: r.acceptance_index,
         common_cells: r.common_cells,
         wall_agreement: r.wall_agreement,
+        stage: r.stage.unwrap_or_default(),
         reason: r.reason.unwrap_or_default(),
     })
 }
@@ -556,7 +560,16 @@ pub fn write_algorithm_summary(rows: &[AlgorithmSummary], path: &Path) -> Result
 pub fn pairs_table(rows: &[PairRow], summary: &[AlgorithmSummary]) -> String {
     let mut s = format!(
         "{:<6} {:<11} {:>5} {:>7}  {:>17}  {:<8} {:>9} {:>9} {:>10}  {}\n",
-        "pair", "algo", "rels", "overlap", "truth floor m/deg", "result", "error m", "error deg", "time ms", "reason"
+        "pair",
+        "algo",
+        "rels",
+        "overlap",
+        "truth floor m/deg",
+        "result",
+        "error m",
+        "error deg",
+        "time ms",
+        "reason or stage"
     );
     for r in rows {
         let result = if r.success {
@@ -579,7 +592,7 @@ pub fn pairs_table(rows: &[PairRow], summary: &[AlgorithmSummary]) -> String {
             r.error.map_or("-".into(), |e| format!("{:.3}", e.0)),
             r.error.map_or("-".into(), |e| format!("{:.2}", e.1)),
             r.time_ms,
-            r.reason
+            if r.accepted && !r.stage.is_empty() { format!("by {}", r.stage) } else { r.reason.clone() }
         );
     }
     let _ = writeln!(

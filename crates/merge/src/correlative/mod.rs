@@ -89,8 +89,8 @@ pub struct CorrelativeParams {
     /// with a margin of 0.13-0.29; ACES's true poses share 270-280 m².
     pub fallback_min_overlap_m2: f64,
     /// Search only the rotations near the peaks of the correlation of the maps' wall-orientation histograms
-    /// ([`orientation`], after Carpin 2008's Hough spectra); false: every rotation (the search as Hess et al.
-    /// describe it).
+    /// (`correlative::orientation`, after Carpin 2008's Hough spectra); false: every rotation (the search as
+    /// Hess et al. describe it).
     pub rotation_prior: bool,
     /// The peaks kept: local maxima scoring at least this share of the highest.
     pub rotation_peak_ratio: f64,
