@@ -202,3 +202,39 @@ fn correlative_refuses_an_ambiguous_pose_naming_the_rival_unless_the_test_is_off
     let (_, r) = run(&["--min-margin", "0"]);
     assert!(!r["reason"].as_str().unwrap_or("").starts_with("ambiguous"), "{r}");
 }
+
+#[test]
+fn correlative_refuses_maps_that_do_not_mark_their_walls_and_the_cascade_still_merges_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    cut_plan(d, 21, "0.5");
+    // Both maps' walls dropped to unknown, as map_server reads light-grey walls: only their boundaries are left.
+    let bare = |name: &str| {
+        let mut g = read_ros_map(&d.join(format!("{name}.yaml"))).unwrap();
+        for y in 0..g.height() {
+            for x in 0..g.width() {
+                if g.state(x, y) == mrslam_core::CellState::Occupied {
+                    g.set(x, y, 0.0);
+                }
+            }
+        }
+        let path = d.join(format!("{name}_bare.yaml"));
+        write_ros_map(&g, &path).unwrap();
+        path
+    };
+    let (a, b) = (bare("a"), bare("b"));
+    let report = d.join("r.json");
+    let run = |algorithm: &str| {
+        let o = mrslam(&["merge", p(&a), p(&b), "--algorithm", algorithm, "--report", p(&report)]);
+        let r: serde_json::Value = serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();
+        (o, r)
+    };
+    let (o, r) = run("correlative");
+    assert_eq!(o.status.code(), Some(2), "{}{}", text(&o.stdout), text(&o.stderr));
+    let reason = r["reason"].as_str().unwrap();
+    assert!(reason.starts_with("map a does not mark its walls (0 occupied cells)"), "{reason}");
+    // The cascade's SIFT stage takes them (their walls from the boundary).
+    let (o, r) = run("cascade");
+    assert_eq!(o.status.code(), Some(0), "{}{}", text(&o.stdout), text(&o.stderr));
+    assert_eq!((r["algorithm"].as_str(), r["stage"].as_str()), (Some("cascade"), Some("sift")), "{r}");
+}

@@ -4,7 +4,8 @@
 //! ```text
 //! sift            the paper's merger on the maps (walls from the boundary of a map that marks none)
 //! sift+boundary   the same with every map's free/unknown boundary as walls (maps that mark only some walls)
-//! correlative     the global search (two robots' maps: doubled walls, doors, people; few shared features)
+//! correlative     the global search (two robots' maps: doubled walls, doors, people; few shared features);
+//!                 refused when a map does not mark its walls (`Merger::needs_marked_walls`)
 //! ```
 //!
 //! The first answer the gate accepts is the merge; a pair every stage refuses is refused with each stage's reason.
@@ -29,13 +30,6 @@ pub struct Stage {
     /// they are, and `Always` already gave the first stage those walls. With `Always`, it is also skipped when
     /// neither map marks its walls: the first stage saw the same walls.
     pub boundary_walls: Option<BoundaryWalls>,
-    /// Run only when both maps mark their walls ([`crate::boundary_walls::marks_its_walls`]).
-    ///
-    /// The correlative search scores a wall of b on a's free space against the pose, and a boundary is a frontier
-    /// as often as a wall: on a generated plan cut at 20 % overlap with its walls dropped, b's frontier lay on a's
-    /// free space at the true pose, which scored 2088 against a 180° flip's 39767, and the flip (12 m off) passed
-    /// the gate.
-    pub needs_marked_walls: bool,
 }
 
 /// Mergers tried in turn through the gate; the first accepted answer is the merge (`--algorithm cascade`).
@@ -49,40 +43,32 @@ impl Cascade {
     pub fn new(sift: SiftMergerParams, correlative: CorrelativeParams) -> Self {
         Cascade {
             stages: vec![
-                Stage {
-                    name: "sift",
-                    merger: Box::new(SiftMerger::new(sift.clone())),
-                    boundary_walls: None,
-                    needs_marked_walls: false,
-                },
+                Stage { name: "sift", merger: Box::new(SiftMerger::new(sift.clone())), boundary_walls: None },
                 Stage {
                     name: "sift+boundary",
                     merger: Box::new(SiftMerger::new(sift)),
                     boundary_walls: Some(BoundaryWalls::Always),
-                    needs_marked_walls: false,
                 },
                 Stage {
                     name: "correlative",
                     merger: Box::new(CorrelativeMerger::new(correlative)),
                     boundary_walls: None,
-                    needs_marked_walls: true,
                 },
             ],
         }
     }
 
-    /// The stages that run on maps that mark their walls or not (`marked`: both do, `some_marked`: one does)
-    /// under the pipeline's parameters, each with the parameters it runs with.
-    fn active(&self, p: &MergeParams, marked: bool, some_marked: bool) -> impl Iterator<Item = (&Stage, MergeParams)> {
-        self.stages.iter().filter(move |s| marked || !s.needs_marked_walls).filter_map(move |s| {
-            match s.boundary_walls {
-                None => Some((s, *p)),
-                Some(BoundaryWalls::Always) if !some_marked => None,
-                Some(mode) if p.boundary_walls == BoundaryWalls::Unmarked => {
-                    Some((s, MergeParams { boundary_walls: mode, ..*p }))
-                }
-                Some(_) => None,
+    /// The stages that run under the pipeline's parameters, each with the parameters it runs with;
+    /// `some_marked`: one of the maps marks its walls (else a stage with the boundary as walls sees what the first
+    /// stage saw).
+    fn active(&self, p: &MergeParams, some_marked: bool) -> impl Iterator<Item = (&Stage, MergeParams)> {
+        self.stages.iter().filter_map(move |s| match s.boundary_walls {
+            None => Some((s, *p)),
+            Some(BoundaryWalls::Always) if !some_marked => None,
+            Some(mode) if p.boundary_walls == BoundaryWalls::Unmarked => {
+                Some((s, MergeParams { boundary_walls: mode, ..*p }))
             }
+            Some(_) => None,
         })
     }
 }
@@ -123,8 +109,7 @@ pub(crate) fn merge_cascade(c: &Cascade, a: &OccupancyGrid, b: &OccupancyGrid, p
     let mut timings = BTreeMap::new();
     let mut reasons = Vec::new();
     let mut last: Option<MergeOutcome> = None;
-    let (marks_a, marks_b) = (marks_its_walls(a), marks_its_walls(b));
-    for (stage, params) in c.active(p, marks_a && marks_b, marks_a || marks_b) {
+    for (stage, params) in c.active(p, marks_its_walls(a) || marks_its_walls(b)) {
         let mut out = merge_one(stage.merger.as_ref(), a, b, &params);
         for (k, v) in std::mem::take(&mut out.report.timings_ms) {
             timings.insert(format!("{}/{k}", stage.name), v);
@@ -184,7 +169,6 @@ mod tests {
             name,
             merger: Box::new(Fixed(vec![t])),
             boundary_walls,
-            needs_marked_walls: false,
         };
         Cascade { stages: stages.iter().map(stage).collect() }
     }
@@ -203,22 +187,39 @@ mod tests {
     }
 
     #[test]
-    fn stages_that_would_see_nothing_new_or_need_marked_walls_are_skipped() {
+    fn a_stage_that_would_see_nothing_new_is_skipped_one_that_needs_marked_walls_refused() {
         let (g, bare) = (room(true), bare_room());
         assert!(marks_its_walls(&g) && !marks_its_walls(&bare));
         let off = pose(1.0, 0.0, 0.0);
-        let mut c =
-            cascade(&[("first", off, None), ("boundary", off, Some(BoundaryWalls::Always)), ("marked", off, None)]);
-        c.stages[2].needs_marked_walls = true;
+        let mut c = cascade(&[("first", off, None), ("boundary", off, Some(BoundaryWalls::Always))]);
+        c.stages.push(Stage { name: "marked", merger: Box::new(NeedsWalls(Fixed(vec![off]))), boundary_walls: None });
         let ran = |a: &OccupancyGrid, b: &OccupancyGrid| -> Vec<&str> {
             let reason = crate::merge(&c, a, b, &MergeParams::default()).report.reason.unwrap();
             ["first", "boundary", "marked"].into_iter().filter(|n| reason.contains(&format!("{n}: "))).collect()
         };
         assert_eq!(ran(&g, &g), ["first", "boundary", "marked"]);
-        // Neither map marks its walls: the first stage already had them from the boundary.
-        assert_eq!(ran(&bare, &bare), ["first"]);
-        // One does: its boundary adds walls the first stage did not see; the correlative-like stage still waits.
-        assert_eq!(ran(&g, &bare), ["first", "boundary"]);
+        // Neither map marks its walls: the first stage already had them from the boundary; the stage that needs
+        // marked walls is refused.
+        assert_eq!(ran(&bare, &bare), ["first", "marked"]);
+        // One does: its boundary adds walls the first stage did not see; the correlative-like stage is refused.
+        assert_eq!(ran(&g, &bare), ["first", "boundary", "marked"]);
+        let reason = crate::merge(&c, &g, &bare, &MergeParams::default()).report.reason.unwrap();
+        assert!(reason.contains("marked: map b does not mark its walls"), "{reason}");
+    }
+
+    /// A fixed answer from an algorithm that needs marked walls.
+    struct NeedsWalls(Fixed);
+
+    impl Merger for NeedsWalls {
+        fn name(&self) -> &'static str {
+            "needs-walls"
+        }
+        fn align(&self, a: &OccupancyGrid, b: &OccupancyGrid) -> Result<Alignment, Box<NoAlignment>> {
+            self.0.align(a, b)
+        }
+        fn needs_marked_walls(&self) -> bool {
+            true
+        }
     }
 
     #[test]

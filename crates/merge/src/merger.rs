@@ -85,6 +85,12 @@ pub trait Merger: Send + Sync {
     fn cascade(&self) -> Option<&crate::Cascade> {
         None
     }
+    /// Whether it needs both maps to mark their walls ([`crate::boundary_walls::marks_its_walls`]): [`merge`]
+    /// refuses, naming the map, a pair where one does not, rather than let the algorithm take a frontier for a
+    /// wall.
+    fn needs_marked_walls(&self) -> bool {
+        false
+    }
 }
 
 /// Parameters of the pipeline around an algorithm.
@@ -243,9 +249,54 @@ pub fn merge(merger: &dyn Merger, a: &OccupancyGrid, b: &OccupancyGrid, p: &Merg
     }
 }
 
+/// Why a map that does not mark its walls cannot go to an algorithm that needs them; None when it does.
+fn unmarked_walls(g: &OccupancyGrid, name: &str) -> Option<String> {
+    (!crate::boundary_walls::marks_its_walls(g)).then(|| {
+        let (_, occupied, _) = g.state_counts();
+        format!(
+            "map {name} does not mark its walls ({occupied} occupied cells): its walls would be its free/unknown \
+             boundary, where a frontier looks like a wall, and this search scores the other map's free space \
+             against them; the sift merger takes such maps"
+        )
+    })
+}
+
+/// The outcome of a merge refused before the gate: no transform, no merged map.
+fn refused(
+    merger: &dyn Merger,
+    reason: String,
+    matches: usize,
+    timings_ms: BTreeMap<String, f64>,
+    start: Instant,
+) -> MergeOutcome {
+    let report = MergeReport {
+        accepted: false,
+        algorithm: merger.name().to_string(),
+        stage: None,
+        transform: None,
+        scale: None,
+        matches,
+        inliers: 0,
+        confidence: 0.0,
+        acceptance_index: None,
+        common_cells: 0,
+        wall_agreement: None,
+        ambiguity: None,
+        reason: Some(reason),
+        time_ms: ms(start),
+        timings_ms,
+    };
+    MergeOutcome { report, merged: None, evidence: Evidence::default() }
+}
+
 /// [`merge`] for one algorithm.
 pub(crate) fn merge_one(merger: &dyn Merger, a: &OccupancyGrid, b: &OccupancyGrid, p: &MergeParams) -> MergeOutcome {
     let start = Instant::now();
+    if merger.needs_marked_walls()
+        && let Some(reason) = unmarked_walls(a, "a").or_else(|| unmarked_walls(b, "b"))
+    {
+        return refused(merger, reason, 0, BTreeMap::new(), start);
+    }
     // Maps that do not mark their walls get them from their free/unknown boundary; the fusion takes the maps as given.
     let (given_a, given_b) = (a, b);
     let walled = |g: &OccupancyGrid| crate::boundary_walls::with_boundary_walls(g, p.boundary_walls);
@@ -254,24 +305,8 @@ pub(crate) fn merge_one(merger: &dyn Merger, a: &OccupancyGrid, b: &OccupancyGri
     let alignment = match merger.align(a, b) {
         Ok(al) => al,
         Err(no) => {
-            let report = MergeReport {
-                accepted: false,
-                algorithm: merger.name().to_string(),
-                stage: None,
-                transform: None,
-                scale: None,
-                matches: no.matches,
-                inliers: 0,
-                confidence: 0.0,
-                acceptance_index: None,
-                common_cells: 0,
-                wall_agreement: None,
-                ambiguity: None,
-                reason: Some(no.reason),
-                time_ms: ms(start),
-                timings_ms: no.timings_ms,
-            };
-            return MergeOutcome { report, merged: None, evidence: no.evidence };
+            let NoAlignment { reason, matches, timings_ms, evidence } = *no;
+            return MergeOutcome { evidence, ..refused(merger, reason, matches, timings_ms, start) };
         }
     };
     let mut timings = alignment.timings_ms.clone();

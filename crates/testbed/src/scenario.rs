@@ -626,7 +626,7 @@ mod tests {
         assert_eq!(s.merge.algorithms, [Algorithm::Sift]);
         let e = two_rooms(|t| t.replace("[\"sift\", \"rmap\"]", "[\"sift\", \"magic\"]")).unwrap_err();
         assert_eq!((e.line, e.field.as_str()), (12, "merge.algorithms"));
-        assert_eq!(e.message, "unknown algorithm `magic` (expected one of sift, rmap, correlative)");
+        assert_eq!(e.message, "unknown algorithm `magic` (expected one of sift, rmap, correlative, cascade)");
     }
 
     #[test]
