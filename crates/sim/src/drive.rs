@@ -100,6 +100,35 @@ impl RobotModel {
         }
     }
 
+    /// Pioneer 2-DX class, the robot of the FR079 log: 16.5 cm wheels on a 0.33 m track (ActivMedia's nominal
+    /// numbers), the 0.47 m × 0.41 m footprint the log's `robot_length`/`robot_width` give; rim speed up to
+    /// 0.75 m/s (the log's `robot_max_t_vel` 0.5 m/s plus a turn at `robot_max_r_vel` 0.78 rad/s, 0.13 m/s at the
+    /// rim, with margin), 9 kg.
+    pub fn pioneer() -> Self {
+        RobotModel {
+            name: "pioneer".into(),
+            wheel_radius: 0.0825,
+            wheel_base: 0.33,
+            footprint: Footprint::Box { length: 0.47, width: 0.41 },
+            max_speed: 0.75,
+            max_accel: 1.0,
+            mass: 9.0,
+        }
+    }
+
+    /// The names of the models, as scenario files give them.
+    pub const PRESETS: [&'static str; 3] = ["experia", "prawn", "pioneer"];
+
+    /// The model called `name` (one of [`RobotModel::PRESETS`]).
+    pub fn preset(name: &str) -> Option<Self> {
+        match name {
+            "experia" => Some(Self::experia()),
+            "prawn" => Some(Self::prawn()),
+            "pioneer" => Some(Self::pioneer()),
+            _ => None,
+        }
+    }
+
     /// Checks every parameter's range.
     pub fn validate(&self) -> Result<(), SimError> {
         check_positive("RobotModel.wheel_radius", self.wheel_radius)?;
@@ -199,6 +228,11 @@ mod tests {
         assert!(e.footprint.bounding_radius() > p.footprint.bounding_radius());
         assert_eq!(e.footprint.half_extents(), (0.25, 0.21));
         assert_eq!(p.footprint.half_extents(), (0.15, 0.15));
+        for name in RobotModel::PRESETS {
+            let m = RobotModel::preset(name).unwrap();
+            assert!(m.validate().is_ok() && m.name == name, "{name}");
+        }
+        assert!(RobotModel::preset("pr2").is_none());
     }
 
     #[test]

@@ -39,6 +39,7 @@ pub mod from_map;
 mod geometry;
 mod lidar;
 pub mod odometry_errors;
+pub mod odometry_fit;
 mod raycast;
 pub mod replay;
 mod sim;

@@ -6,7 +6,7 @@
 use mrslam_core::toml_lines::{TomlLines, line_at};
 use mrslam_core::{Pose2, pose};
 use mrslam_merge::{Algorithm, MapEncoding, Model};
-use mrslam_sim::{EncoderParams, LidarModel, RobotModel, SlipParams, World, WorldSpec};
+use mrslam_sim::{EncoderParams, LidarModel, RobotModel, SlipParams, World, WorldSpec, odometry_fit};
 use mrslam_slam::SlamParams;
 use nalgebra::Point2;
 use serde::Deserialize;
@@ -237,6 +237,7 @@ struct RobotFile {
     controller: Option<String>,
     speed: Option<f64>,
     lookahead: Option<f64>,
+    odometry: Option<String>,
     #[serde(default)]
     slip: SlipFile,
     #[serde(default)]
@@ -389,13 +390,20 @@ fn resolve_robot(
     world: &World,
 ) -> Result<RobotSetup, ScenarioError> {
     let f = |name: &str| format!("robots[{i}].{name}");
-    let model = match r.model.as_str() {
-        "experia" => RobotModel::experia(),
-        "prawn" => RobotModel::prawn(),
-        m => return Err(cx.err(f("model"), format!("unknown robot model `{m}` (expected experia or prawn)"))),
-    };
+    let model = RobotModel::preset(&r.model).ok_or_else(|| {
+        let names = RobotModel::PRESETS.join(", ");
+        cx.err(f("model"), format!("unknown robot model `{}` (expected one of {names})", r.model))
+    })?;
     let lidar = resolve_lidar(cx, &f("lidar"), &r.lidar)?;
-    let mut slip = if r.slip.none == Some(true) { SlipParams::none() } else { SlipParams::default() };
+    // An odometry preset gives the slip and encoder parameters the tables below start from.
+    let (base_slip, base_encoder) = match &r.odometry {
+        None => (SlipParams::default(), EncoderParams::default()),
+        Some(name) => odometry_fit::preset(name).ok_or_else(|| {
+            let names = odometry_fit::PRESETS.join(", ");
+            cx.err(f("odometry"), format!("unknown odometry preset `{name}` (expected one of {names})"))
+        })?,
+    };
+    let mut slip = if r.slip.none == Some(true) { SlipParams::none() } else { base_slip };
     let s = &r.slip;
     apply(&mut [
         (&mut slip.speed_noise, s.speed_noise),
@@ -407,7 +415,7 @@ fn resolve_robot(
         (&mut slip.event_magnitude, s.event_magnitude),
     ]);
     slip.validate().map_err(|e| cx.err(f("slip"), e.to_string()))?;
-    let mut encoder = EncoderParams::default();
+    let mut encoder = base_encoder;
     let e = &r.encoder;
     apply(&mut [(&mut encoder.ticks_per_rev, e.ticks_per_rev)]);
     apply(&mut [
