@@ -7,6 +7,7 @@ pub mod map;
 pub mod merge;
 pub mod merge_many;
 pub mod paths;
+pub mod replay_plot;
 pub mod run;
 pub mod sim;
 pub mod slam;

@@ -81,6 +81,9 @@ fn the_simulators_own_log_replays_in_its_world_with_no_residual() {
     assert_eq!((replay["real_missing"].as_u64(), replay["real_extra"].as_u64()), (Some(0), Some(0)), "{replay}");
     assert!(replay["both"].as_u64().unwrap() > replay["beams"].as_u64().unwrap() / 2, "{replay}");
     assert!(replay["fitted_noise_const_m"].as_f64().unwrap() < 1e-4, "{replay}");
+    // The residual histograms beside the report; no odometry picture without a trajectory.
+    assert_png(&d.join("replay.residuals.png"), (1500, 900));
+    assert!(!d.join("replay.odometry.png").exists());
 
     // With the true trajectory: the same residuals, the log's odometry (the truth itself) without error, and the
     // scenario's robots driven along it with theirs.
@@ -113,6 +116,12 @@ fn the_simulators_own_log_replays_in_its_world_with_no_residual() {
     assert!(log_errors["translation_per_m"]["segments"].as_u64().unwrap() >= 3, "{log_errors}");
     assert!(log_errors["translation_per_m"]["rms"].as_f64().unwrap() < 1e-4, "{log_errors}");
     assert!(log_errors["scale_per_m"]["rms"].as_f64().unwrap() < 1e-4, "{log_errors}");
+    assert_png(&d.join("replay.residuals.png"), (1500, 900));
+    assert_png(&d.join("replay.odometry.png"), (1100, 1000));
+    // Each band's histogram holds its inliers.
+    let band = &r["replay"]["by_range"][1];
+    let counted: u64 = band["histogram"]["real"].as_array().unwrap().iter().map(|c| c.as_u64().unwrap()).sum();
+    assert_eq!(counted, band["beams"].as_u64().unwrap() - band["outliers"].as_u64().unwrap(), "{band}");
 
     // A trajectory without the log's stamps: refused, saying so.
     let traj = d.join("t.txt");
@@ -124,4 +133,37 @@ fn the_simulators_own_log_replays_in_its_world_with_no_residual() {
     let o = mrslam(&["sim", "replay", p(&log), "--world", p(&world), "--report", p(&world)]);
     assert_eq!(o.status.code(), Some(1));
     assert_eq!(std::fs::read_to_string(&world).unwrap(), ROOM);
+    // A report whose picture would overwrite an input (here the trajectory): refused, the input untouched.
+    let named = d.join("t.residuals.png");
+    std::fs::copy(&truth, &named).unwrap();
+    let before = std::fs::read(&named).unwrap();
+    let o = mrslam(&[
+        "sim",
+        "replay",
+        p(&log),
+        "--world",
+        p(&world),
+        "--trajectory",
+        p(&named),
+        "--report",
+        p(&d.join("t.json")),
+    ]);
+    assert_eq!(o.status.code(), Some(1), "{}", text(&o.stderr));
+    assert_eq!(std::fs::read(&named).unwrap(), before);
+    assert!(!d.join("t.json").exists());
+    // Fitting odometry needs the scenario's robots.
+    let o = mrslam(&["sim", "replay", p(&log), "--world", p(&world), "--trajectory", p(&truth), "--fit-odometry"]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(text(&o.stderr).contains("--fit-odometry"), "{}", text(&o.stderr));
+}
+
+/// `path` is a PNG of `size` pixels with something drawn on it (a plot, not an empty canvas).
+fn assert_png(path: &Path, size: (u32, u32)) {
+    let bytes = std::fs::read(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    assert!(bytes.starts_with(b"\x89PNG\r\n\x1a\n"), "{} is not a PNG", path.display());
+    assert!(bytes.len() > 10_000, "{}: only {} bytes", path.display(), bytes.len());
+    let img = image::load_from_memory(&bytes).unwrap().to_rgb8();
+    assert_eq!(img.dimensions(), size);
+    let drawn = img.pixels().filter(|p| p.0 != [255, 255, 255]).count();
+    assert!(drawn > 5_000, "{}: {drawn} pixels drawn", path.display());
 }

@@ -29,6 +29,33 @@ pub const RANGE_BANDS_M: [f64; 5] = [0.0, 1.0, 3.0, 6.0, 10.0];
 pub const INCIDENCE_BANDS_DEG: [f64; 3] = [0.0, 30.0, 60.0];
 /// A residual larger than this is an outlier, metres.
 pub const OUTLIER_M: f64 = 0.3;
+/// Width of a bin of the residual histograms, metres; they cover ±[`OUTLIER_M`].
+pub const HISTOGRAM_BIN_M: f64 = 0.01;
+
+/// Counts of a band's inlier residuals in bins of [`HISTOGRAM_BIN_M`] from −[`OUTLIER_M`] to +[`OUTLIER_M`]: the
+/// real ones and those drawn for the KS comparisons.
+#[derive(Debug, Clone, PartialEq, Default, serde::Serialize)]
+pub struct Histogram {
+    /// The real residuals.
+    pub real: Vec<usize>,
+    /// Drawn from the fitted model plus the band's median.
+    pub fitted: Vec<usize>,
+    /// Drawn from the lidar model given to the replay.
+    pub model: Vec<usize>,
+}
+
+/// The counts of `v` in the histogram's bins (values outside ±[`OUTLIER_M`] left out).
+fn histogram(v: &[f64]) -> Vec<usize> {
+    let bins = (2.0 * OUTLIER_M / HISTOGRAM_BIN_M).round() as usize;
+    let mut h = vec![0; bins];
+    for x in v {
+        let k = ((x + OUTLIER_M) / HISTOGRAM_BIN_M).floor();
+        if k >= 0.0 && (k as usize) < bins {
+            h[k as usize] += 1;
+        }
+    }
+    h
+}
 
 /// The residuals of one band.
 #[derive(Debug, Clone, PartialEq, Default, serde::Serialize)]
@@ -52,6 +79,8 @@ pub struct BandStats {
     pub ks_fitted: Option<f64>,
     /// The same against the lidar model given to the replay (zero-mean, as the simulator draws it).
     pub ks_model: Option<f64>,
+    /// The residuals' histograms, real and drawn.
+    pub histogram: Histogram,
 }
 
 /// What a replay found.
@@ -147,6 +176,7 @@ pub fn replay<'a>(
             let (fitted, model) = (draw((a, b), bias), draw(model_noise, 0.0));
             s.ks_fitted = ks_statistic(&real, &fitted);
             s.ks_model = ks_statistic(&real, &model);
+            s.histogram = Histogram { real: histogram(&real), fitted: histogram(&fitted), model: histogram(&model) };
         }
     }
     r
@@ -202,6 +232,7 @@ fn band_stats(groups: &[Vec<&Beam>], edges: &[f64]) -> Vec<BandStats> {
                 mean_range_m: if ranges.is_empty() { 0.0 } else { ranges.iter().sum::<f64>() / ranges.len() as f64 },
                 ks_fitted: None,
                 ks_model: None,
+                histogram: Histogram::default(),
             }
         })
         .collect()
@@ -352,6 +383,13 @@ radius = 0.3
         let far = r.by_range.iter().find(|b| b.from == 3.0).unwrap();
         assert!(far.ks_fitted.unwrap() < 0.1, "the fitted model's residuals look like the real ones: {far:?}");
         assert!(far.ks_model.unwrap() > 0.3, "a model without the proportional noise does not: {far:?}");
+        // The histograms hold every inlier, real and drawn alike (none falls outside ±OUTLIER_M by construction).
+        let h = &far.histogram;
+        assert_eq!(h.real.len(), 60);
+        let inliers = far.beams - far.outliers;
+        assert_eq!(h.real.iter().sum::<usize>(), inliers);
+        let drawn: usize = h.fitted.iter().sum();
+        assert!(drawn <= inliers && drawn + inliers / 50 >= inliers, "{drawn} of {inliers}");
     }
 
     #[test]
