@@ -205,9 +205,17 @@ pub fn placed_at(start: &Pose2, odom: &[Pose2]) -> Vec<Pose2> {
 }
 
 /// A simulated robot's odometry error against its own true poses `truth` (which slip takes off the reference),
-/// carried onto `reference`: at each instant `reference · truth⁻¹ · odom`, both placed at the first pose.
+/// carried onto `reference` step by step: each step of the reference followed by that step's odometry error
+/// (`(truth step)⁻¹ · odometry step`), from the reference's first pose: the odometry the robot would have read
+/// driving the reference itself.
 pub fn error_on_reference(reference: &[Pose2], truth: &[Pose2], odom: &[Pose2]) -> Vec<Pose2> {
-    let Some(t0) = truth.first() else { return Vec::new() };
-    let placed = placed_at(t0, odom);
-    reference.iter().zip(truth).zip(&placed).map(|((r, t), o)| r * t.inv_mul(o)).collect()
+    let Some(&first) = reference.first() else { return Vec::new() };
+    let mut out = vec![first];
+    let n = reference.len().min(truth.len()).min(odom.len());
+    for k in 1..n {
+        let error = truth[k - 1].inv_mul(&truth[k]).inv_mul(&odom[k - 1].inv_mul(&odom[k]));
+        let last = out[k - 1];
+        out.push(last * reference[k - 1].inv_mul(&reference[k]) * error);
+    }
+    out
 }
