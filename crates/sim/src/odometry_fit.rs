@@ -185,11 +185,6 @@ pub fn fit(
     Ok(Fitted { slip, encoder, errors, loss: best, evaluations: evaluations.get() })
 }
 
-/// A spread's mean and standard deviation as `+m ± s (n)`.
-pub fn format_spread(s: &Spread) -> String {
-    format!("{:+.4} ± {:.4} ({})", s.mean, s.std, s.segments)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
