@@ -100,8 +100,9 @@ impl RobotModel {
         }
     }
 
-    /// Pioneer 2-DX class, the robot of the FR079 log: 16.5 cm wheels on a 0.33 m track (ActivMedia's nominal
-    /// numbers), the 0.47 m × 0.41 m footprint the log's `robot_length`/`robot_width` give; rim speed up to
+    /// Pioneer 2-DX class, the robot of the FR079 log: 16.5 cm wheels on a 0.33 m track (the class's nominal
+    /// numbers, not the log's: an odometry fit to the log absorbs a different track in its radius and base errors),
+    /// the 0.47 m × 0.41 m footprint the log's `robot_length`/`robot_width` give; rim speed up to
     /// 0.75 m/s (the log's `robot_max_t_vel` 0.5 m/s plus a turn at `robot_max_r_vel` 0.78 rad/s, 0.13 m/s at the
     /// rim, with margin), 9 kg.
     pub fn pioneer() -> Self {
