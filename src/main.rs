@@ -56,7 +56,20 @@ enum Command {
     Study(cmd::study::StudyCommand),
 }
 
+/// A closed pipe (`mrslam ... | head`) ends the process as it ends other Unix tools, by SIGPIPE, instead of a
+/// panic at the next print (Rust ignores SIGPIPE, so `println!` would meet EPIPE). Outputs are written under
+/// temporary names and renamed when complete, so a run ended this way leaves nothing that looks complete.
+fn restore_sigpipe() {
+    #[cfg(unix)]
+    // SAFETY: called first thing in `main`, before any other thread exists; SIG_DFL is a valid disposition for
+    // SIGPIPE and no Rust code relies on SIGPIPE being ignored here.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
+}
+
 fn main() -> ExitCode {
+    restore_sigpipe();
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
         Err(e) => {

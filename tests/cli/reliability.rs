@@ -157,3 +157,26 @@ fn nothing_doubtful_is_accepted_quietly() {
     std::fs::write(d.join("cut.clf.gz"), &bytes[..bytes.len() / 2]).unwrap();
     fails_with(&["log", "info", p(&d.join("cut.clf.gz"))], &["cut.clf.gz", "cut off"]);
 }
+
+#[cfg(unix)]
+#[test]
+fn output_into_a_closed_pipe_ends_quietly_without_a_panic() {
+    use std::os::unix::process::ExitStatusExt;
+    use std::process::{Command, Stdio};
+    // `mrslam map info plan.yaml | head -0`: the reader is gone before mrslam prints (a reader that had read
+    // the first line would leave the same EPIPE for the next one).
+    let dir = tempfile::tempdir().unwrap();
+    let map = plan(dir.path(), "plan", 4);
+    let mut child = Command::new(env!("CARGO_BIN_EXE_mrslam"))
+        .args(["map", "info", p(&map)])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    let e = text(&out.stderr);
+    assert!(!e.contains("panicked"), "{e}");
+    // Killed by SIGPIPE as other Unix tools are, or done before the reader closed: never a panic's exit 101.
+    assert!(out.status.signal() == Some(libc::SIGPIPE) || out.status.success(), "{:?}: {e}", out.status);
+}
