@@ -38,6 +38,7 @@ fn set(p: &mut CorrelativeParams, kv: &str) {
         "rdist" => p.rival_distinct_m = f,
         "rivals" => p.rivals = f as usize,
         "fbrivals" => p.fallback_rivals = f as usize,
+        "fbalways" => p.fallback_always = f != 0.0,
         _ => panic!("unknown key {k}"),
     }
 }

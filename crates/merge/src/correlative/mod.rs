@@ -15,7 +15,8 @@
 //! each: a window at a's resolution (branch and bound; rayon) local::local_search
 //! the strongest: wall ICP, scored again, ranked        refine::refine
 //! significance: best against the best 2 m or more away Significance (Lowe's ratio test)
-//! not settled: a second search with a softer penalty   fallback_free_penalty, answers pooled
+//! a second search with a softer penalty, pooled:      fallback_free_penalty (rivals; its own winner
+//!     needs fallback_min_overlap_m2)                   fallback_always
 //! hypotheses: least shared area and acceptance         verify::agreement
 //! ```
 //!
@@ -88,6 +89,15 @@ pub struct CorrelativeParams {
     /// 18 m plans cut apart (nothing shared), 180° flips laid wall on wall over 23-36 m² (acceptance 0.95-0.99)
     /// with a margin of 0.13-0.29; ACES's true poses share 270-280 m².
     pub fallback_min_overlap_m2: f64,
+    /// Run the fallback search even when the first settles the pair, its answers pooled as rivals of the first's
+    /// winner (which keeps its own [`CorrelativeParams::min_overlap_m2`] unless a fallback answer beats it); false:
+    /// only when the first does not settle it (before 2026-12-02).
+    ///
+    /// Small maps of the ACES log (the log cut in 9 parts) made the strict search's winner a 180° flip: at the
+    /// true pose more of b's walls fall on a's free space (48 against 31 points of 397), so the truth scored a
+    /// tenth of the flip and was pruned; the tolerant search finds it, and on the fine field it leads the flip
+    /// or comes within the significance margin of it, so the pair is refused instead of merged 4-18 m off.
+    pub fallback_always: bool,
     /// Search only the rotations near the peaks of the correlation of the maps' wall-orientation histograms
     /// (`correlative::orientation`, after Carpin 2008's Hough spectra); false: every rotation (the search as
     /// Hess et al. describe it).
@@ -176,6 +186,7 @@ impl Default for CorrelativeParams {
             fine_free_penalty: 2.0,
             fallback_free_penalty: 1.0,
             fallback_min_overlap_m2: 100.0,
+            fallback_always: true,
             rotation_prior: true,
             rotation_peak_ratio: 0.3,
             rotation_tolerance_deg: 4.0,
@@ -323,6 +334,8 @@ struct Candidates {
     scan_points: Vec<Point2<f64>>,
     /// Least shared area a hypothesis needs, m²: more when the fallback search was needed.
     min_overlap_m2: f64,
+    /// The best polished answer came from the first of the searches pooled.
+    best_from_first: bool,
 }
 
 /// The global score of `t_a_b` (the best within two search cells and two angular steps of it), and how many
@@ -583,6 +596,8 @@ impl CorrelativeMerger {
             })
             .collect();
         polished.sort_by(|x, y| y.2.cmp(&x.2).then(x.0.cmp(&y.0)));
+        let from_first = searches.first().map_or(0, |f| f.poses.len() + f.rivals.len());
+        let best_from_first = polished[0].0 < from_first;
         // The significance test: the best polished answer against every one clearly apart from it.
         let moved = |t: &Pose2, u: &Pose2| max_displacement(&scan, t, u);
         let (best, best_score) = (polished[0].1, polished[0].2);
@@ -595,6 +610,7 @@ impl CorrelativeMerger {
             significance,
             scan_points: scan.points.iter().map(|v| scan.centroid + v).collect(),
             min_overlap_m2: p.min_overlap_m2,
+            best_from_first,
         }
     }
 
@@ -614,7 +630,11 @@ impl CorrelativeMerger {
             c.significance.refusal(p.min_margin).is_none()
                 && !self.shared(a, b, &c.refined, c.min_overlap_m2).0.is_empty()
         };
-        if p.fallback_free_penalty <= 0.0 || p.fallback_free_penalty == p.free_penalty || settles(&first) {
+        let first_settles = settles(&first);
+        if p.fallback_free_penalty <= 0.0
+            || p.fallback_free_penalty == p.free_penalty
+            || (first_settles && !p.fallback_always)
+        {
             return Ok(first);
         }
         let tolerant = CorrelativeMerger::new(CorrelativeParams {
@@ -630,7 +650,11 @@ impl CorrelativeMerger {
             timings.insert(format!("fallback_{k}"), v);
         }
         let mut pooled = self.candidates(a, b, &[&strict, &second], timings);
-        pooled.min_overlap_m2 = p.min_overlap_m2.max(p.fallback_min_overlap_m2);
+        // A pose only the tolerant search found needs the larger shared area; the first search's settled answer,
+        // now tested against the tolerant search's rivals too, keeps its own.
+        if !first_settles || !pooled.best_from_first {
+            pooled.min_overlap_m2 = p.min_overlap_m2.max(p.fallback_min_overlap_m2);
+        }
         Ok(pooled)
     }
 
@@ -743,7 +767,7 @@ impl Merger for CorrelativeMerger {
     fn align(&self, a: &OccupancyGrid, b: &OccupancyGrid) -> Result<Alignment, Box<NoAlignment>> {
         let p = &self.params;
         let mut timings = BTreeMap::new();
-        let Candidates { refined, significance, scan_points, min_overlap_m2 } = self.settled(a, b, &mut timings)?;
+        let Candidates { refined, significance, scan_points, min_overlap_m2, .. } = self.settled(a, b, &mut timings)?;
         if let Some(reason) = significance.refusal(p.min_margin) {
             return Err(fail(reason, timings));
         }
