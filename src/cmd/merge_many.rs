@@ -73,7 +73,8 @@ fn xyt(t: &Xyt) -> String {
     format!("x {:.3} m, y {:.3} m, theta {:.4} rad ({:.2} deg)", t.x, t.y, t.theta, t.theta.to_degrees())
 }
 
-/// The human summary of an N-map merge: a line per pair, the tree, each map's transform, the maps left out.
+/// The human summary of an N-map merge: a line per pair, the tree, each map's transform, the maps left out, the
+/// accepted pairs the tree contradicts.
 pub fn summary(r: &MultiReport, files: &[&PathBuf]) -> String {
     let name = |i: usize| files.get(i).map_or_else(|| format!("map {i}"), |f| short(f));
     let joined = r.maps - r.not_connected.len();
@@ -108,6 +109,18 @@ pub fn summary(r: &MultiReport, files: &[&PathBuf]) -> String {
         } else {
             s += &format!("left out:   {} join each other but not {}\n", names.join(", "), name(0));
         }
+    }
+    // An accepted pair the tree's chain contradicts: a pair on that cycle is wrong, so a placement may be too.
+    for d in &r.disagreements {
+        let q = &r.pairs[d.pair];
+        s += &format!(
+            "WARNING:    {} + {} was accepted {:.1} deg and {:.2} m away from the tree's chain between them: one of \
+             the pairs on that cycle is wrong, check the placements\n",
+            name(q.a),
+            name(q.b),
+            d.rotation_deg,
+            d.translation_m
+        );
     }
     s += &format!("time:       {:.1} ms\n", r.time_ms);
     s

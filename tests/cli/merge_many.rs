@@ -60,12 +60,14 @@ fn three_maps_are_placed_in_the_first_maps_frame() {
     assert!(out.contains("a.yaml + b.yaml: ACCEPTED"), "{out}");
     assert!(out.contains("tree") && out.contains(" -> "), "{out}");
     assert!(!out.contains("left out"), "{out}");
+    assert!(!out.contains("WARNING"), "every cycle of accepted pairs closes: {out}");
     let report: serde_json::Value = serde_json::from_slice(&std::fs::read(&r).unwrap()).unwrap();
     assert_eq!(report["maps"], 3);
     assert_eq!(report["pairs"].as_array().unwrap().len(), 3);
     assert_eq!(report["pairs"][0]["report"]["accepted"], true, "{report}");
     assert_eq!(report["tree"].as_array().unwrap().len(), 2);
     assert_eq!(report["not_connected"].as_array().unwrap().len(), 0);
+    assert_eq!(report["disagreements"].as_array().unwrap().len(), 0);
     assert_eq!(report["files"][2].as_str().unwrap(), p(&c));
     check_transforms(&report, &truth, 0.1);
     let merged = read_ros_map(&m).unwrap();

@@ -55,7 +55,7 @@ pub use fuse::FusionRule;
 pub use map_image::{MapEncoding, MapImage};
 pub use matching::MatchParams;
 pub use merger::{Alignment, Evidence, MergeOutcome, MergeParams, Merger, NoAlignment, merge};
-pub use multi::{MultiOutcome, MultiReport, PairReport, TreeEdge, merge_many};
+pub use multi::{DISAGREE_DEG, DISAGREE_M, Disagreement, MultiOutcome, MultiReport, PairReport, TreeEdge, merge_many};
 pub use refine::RefineParams;
 pub use report::MergeReport;
 pub use rmap::{CoverRule, OrientParams, RmapMerger, RmapParams, RmapResult, TriangleMatch, TriangleParams};

@@ -36,6 +36,26 @@ pub struct TreeEdge {
     pub transform: Xyt,
 }
 
+/// An accepted pair the spanning tree contradicts: its transform and the tree's chain between its maps differ by
+/// more than [`DISAGREE_M`] or [`DISAGREE_DEG`], so one of the pairs on that cycle is wrong.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Disagreement {
+    /// Index of the pair in [`MultiReport::pairs`] (not a tree edge).
+    pub pair: usize,
+    /// How far the chain's `T_a_b` moves the pair's: translation, metres.
+    pub translation_m: f64,
+    /// And rotation, degrees.
+    pub rotation_deg: f64,
+}
+
+/// A pair and the tree's chain between its maps disagree beyond this translation, metres: correct pairs of real
+/// SLAM maps are 0.03-0.15 m off the truth (benchmarks/runs/2026-12-02-merge-cascade.md), so a chain of a few of
+/// them stays well inside; the wrong answers seen are metres off.
+pub const DISAGREE_M: f64 = 1.0;
+
+/// Or beyond this rotation, degrees (correct pairs: below 1°; wrong ones seen: 90° and 180°).
+pub const DISAGREE_DEG: f64 = 5.0;
+
 /// What [`merge_many`] reports (also the JSON `mrslam merge` writes for three or more maps).
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct MultiReport {
@@ -53,6 +73,9 @@ pub struct MultiReport {
     pub components: Vec<Vec<usize>>,
     /// Maps not joined to map 0, ascending (empty when every map is connected).
     pub not_connected: Vec<usize>,
+    /// Accepted pairs outside the tree that its chains contradict, in pair order (empty when every cycle closes).
+    #[serde(default)]
+    pub disagreements: Vec<Disagreement>,
     /// Wall time of all the pairwise merges, the tree and the fusion, milliseconds.
     pub time_ms: f64,
 }
@@ -149,6 +172,27 @@ fn orient(n: usize, forest: &[Edge]) -> (Vec<Vec<usize>>, Vec<TreeEdge>, Vec<Pos
     (components, tree, to_root)
 }
 
+/// The accepted pairs outside the forest whose transform the forest's chain between their maps contradicts
+/// (`to_root`: each map's `T_root_i` within its component).
+fn disagreements(edges: &[Edge], forest: &[Edge], components: &[Vec<usize>], to_root: &[Pose2]) -> Vec<Disagreement> {
+    let component = |i: usize| components.iter().position(|c| c.contains(&i));
+    edges
+        .iter()
+        .filter(|e| !forest.iter().any(|f| f.0 == e.0))
+        .filter(|e| component(e.1).is_some() && component(e.1) == component(e.2))
+        .filter_map(|&(pair, a, b, _, t_a_b)| {
+            let chain = to_root[a].inverse() * to_root[b];
+            let d = chain.inverse() * t_a_b;
+            let (translation_m, rotation_deg) = (d.translation.vector.norm(), d.rotation.angle().abs().to_degrees());
+            (translation_m > DISAGREE_M || rotation_deg > DISAGREE_DEG).then_some(Disagreement {
+                pair,
+                translation_m,
+                rotation_deg,
+            })
+        })
+        .collect()
+}
+
 /// Merges N maps: [`merge`] on every pair (in parallel, reported in pair order), a maximum spanning tree of
 /// the accepted pairs by confidence rooted at map 0, each map's transform into map 0's frame along the tree,
 /// and the maps joined to map 0 fused one by one (tree order) onto map 0 with `params.fusion`.
@@ -174,6 +218,7 @@ pub fn merge_many(merger: &dyn Merger, maps: &[OccupancyGrid], params: &MergePar
     let transforms: Vec<Option<Xyt>> =
         (0..n).map(|i| joined.contains(&i).then(|| Xyt::from_pose(&to_root[i]))).collect();
     let not_connected: Vec<usize> = (0..n).filter(|i| !joined.contains(i)).collect();
+    let disagreements = disagreements(&edges, &forest, &components, &to_root);
     // Fused in tree order (breadth first from map 0): each map lands next to maps already in.
     let merged = (joined.len() > 1).then(|| {
         tree.iter()
@@ -188,6 +233,7 @@ pub fn merge_many(merger: &dyn Merger, maps: &[OccupancyGrid], params: &MergePar
         transforms,
         components,
         not_connected,
+        disagreements,
         time_ms: start.elapsed().as_secs_f64() * 1e3,
     };
     MultiOutcome { report, merged }
@@ -216,6 +262,31 @@ mod tests {
         let tie = vec![(4, 1, 2, 0.5, t), (0, 0, 1, 0.5, t), (2, 0, 2, 0.5, t)];
         let kept: Vec<usize> = spanning_forest(3, &tie).iter().map(|e| e.0).collect();
         assert_eq!(kept, vec![0, 2]);
+    }
+
+    #[test]
+    fn an_accepted_pair_the_tree_contradicts_is_reported() {
+        let (t01, t12) = (pose(1.0, 2.0, 0.3), pose(-0.5, 1.5, -1.1));
+        let t02 = t01 * t12;
+        // A triangle whose weakest edge (0-2) agrees with the chain 0-1-2, then one that is a half turn off.
+        for (t, off) in [(t02, false), (t02 * pose(0.3, -0.2, std::f64::consts::PI), true)] {
+            let edges = vec![(0, 0, 1, 0.9, t01), (1, 0, 2, 0.2, t), (2, 1, 2, 0.8, t12)];
+            let forest = spanning_forest(3, &edges);
+            let (components, _, to_root) = orient(3, &forest);
+            let d = disagreements(&edges, &forest, &components, &to_root);
+            if off {
+                assert_eq!(d.len(), 1, "{d:?}");
+                assert_eq!(d[0].pair, 1);
+                assert!((d[0].rotation_deg - 180.0).abs() < 1e-6, "{d:?}");
+            } else {
+                assert!(d.is_empty(), "{d:?}");
+            }
+        }
+        // Pairs in different components are not compared (no chain joins them).
+        let edges = vec![(0, 0, 1, 0.9, t01), (1, 2, 3, 0.5, t12)];
+        let forest = spanning_forest(4, &edges);
+        let (components, _, to_root) = orient(4, &forest);
+        assert!(disagreements(&edges, &forest, &components, &to_root).is_empty());
     }
 
     #[test]
