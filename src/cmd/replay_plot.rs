@@ -3,13 +3,12 @@
 //! reference path, the log's odometry and each simulated robot's, all placed at the first pose). Drawn with
 //! plotters into a buffer, written under a temporary name and renamed.
 
-use anyhow::{Context, Result, anyhow};
+use anyhow::{Result, anyhow};
 use mrslam_core::Pose2;
 use mrslam_sim::replay::{BandStats, HISTOGRAM_BIN_M, OUTLIER_M, ReplayReport};
+use mrslam_studies::plot::{register_sans_serif, write_rgb_png};
 use plotters::prelude::*;
-use plotters::style::{FontStyle, register_font};
 use std::path::{Path, PathBuf};
-use std::sync::Once;
 
 /// Size of `R.residuals.png`, pixels.
 pub const RESIDUALS_SIZE: (u32, u32) = (1500, 900);
@@ -24,26 +23,10 @@ const COLOURS: [RGBColor; 5] = [
     RGBColor(255, 127, 14),
 ];
 
-fn register() {
-    static ONCE: Once = Once::new();
-    ONCE.call_once(|| {
-        // Should the compiled-in font ever fail to load, text is dropped, not the plot.
-        let _ = register_font("sans-serif", FontStyle::Normal, epaint_default_fonts::UBUNTU_LIGHT);
-    });
-}
-
 /// `R.json` → `R.<what>.png` beside it.
 pub fn plot_path(report: &Path, what: &str) -> PathBuf {
     let stem = report.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
     report.with_file_name(format!("{stem}.{what}.png"))
-}
-
-/// Writes an RGB buffer of `size` as a PNG at `path` (temporary name, then renamed).
-fn write_png(buf: Vec<u8>, size: (u32, u32), path: &Path) -> Result<()> {
-    let img = image::RgbImage::from_raw(size.0, size.1, buf).ok_or_else(|| anyhow!("plot buffer of the wrong size"))?;
-    let mut bytes = Vec::new();
-    img.write_to(&mut std::io::Cursor::new(&mut bytes), image::ImageFormat::Png)?;
-    mrslam_core::map_io::write_file_atomic(path, &bytes).with_context(|| format!("writing {}", path.display()))
 }
 
 /// A histogram's counts as densities (per metre) at the bins' centres.
@@ -62,7 +45,7 @@ fn band_name(b: &BandStats) -> String {
 
 /// Draws the residual histograms of every range band of `r` into `path`; `lidar` names the model compared.
 pub fn residuals(r: &ReplayReport, lidar: &str, path: &Path) -> Result<()> {
-    register();
+    register_sans_serif();
     let (w, h) = RESIDUALS_SIZE;
     let mut buf = vec![255u8; (w * h * 3) as usize];
     {
@@ -136,12 +119,12 @@ pub fn residuals(r: &ReplayReport, lidar: &str, path: &Path) -> Result<()> {
         }
         root.present().map_err(|e| anyhow!("{e}"))?;
     }
-    write_png(buf, (w, h), path)
+    Ok(write_rgb_png(buf, (w, h), path)?)
 }
 
 /// Draws named paths (the first is the reference) into `path`, axes in metres with equal scales.
 pub fn odometry(paths: &[(String, Vec<Pose2>)], path: &Path) -> Result<()> {
-    register();
+    register_sans_serif();
     let (w, h) = ODOMETRY_SIZE;
     let pts = |p: &[Pose2]| -> Vec<(f64, f64)> { p.iter().map(|q| (q.translation.x, q.translation.y)).collect() };
     let all: Vec<(f64, f64)> = paths.iter().flat_map(|(_, p)| pts(p)).filter(|p| p.0.is_finite()).collect();
@@ -194,7 +177,7 @@ pub fn odometry(paths: &[(String, Vec<Pose2>)], path: &Path) -> Result<()> {
             .map_err(|e| anyhow!("{e}"))?;
         root.present().map_err(|e| anyhow!("{e}"))?;
     }
-    write_png(buf, (w, h), path)
+    Ok(write_rgb_png(buf, (w, h), path)?)
 }
 
 /// `odom` (poses in its own frame) placed so that its first pose lies on `start`.

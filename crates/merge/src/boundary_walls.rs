@@ -75,36 +75,60 @@ fn boundary_cells(grid: &OccupancyGrid) -> Vec<(usize, usize)> {
     out
 }
 
-/// Whether `grid` marks its walls: as many occupied cells as [`BOUNDARY_STYLE_RATIO`] of its free/unknown boundary
-/// cells (or no such boundary at all).
+/// A map's free/unknown boundary, found once: whether the map marks its walls, and its walls in any mode.
+#[derive(Debug, Clone)]
+pub struct Boundary {
+    /// Unknown cells touching free space.
+    cells: Vec<(usize, usize)>,
+    /// Occupied cells in the map.
+    occupied: usize,
+}
+
+impl Boundary {
+    /// The boundary of `grid`.
+    pub fn of(grid: &OccupancyGrid) -> Self {
+        let (_, occupied, _) = grid.state_counts();
+        Boundary { cells: boundary_cells(grid), occupied }
+    }
+
+    /// Occupied cells in the map.
+    pub fn occupied(&self) -> usize {
+        self.occupied
+    }
+
+    /// Whether the map marks its walls: as many occupied cells as [`BOUNDARY_STYLE_RATIO`] of its boundary cells
+    /// (or no boundary at all).
+    pub fn marks_its_walls(&self) -> bool {
+        self.cells.is_empty() || self.occupied as f64 >= BOUNDARY_STYLE_RATIO * self.cells.len() as f64
+    }
+
+    /// `grid` (the map this boundary is of) with walls on the boundary when `mode` asks for them; `None`: use it
+    /// as it is.
+    pub fn walls(&self, grid: &OccupancyGrid, mode: BoundaryWalls) -> Option<OccupancyGrid> {
+        let wanted = match mode {
+            BoundaryWalls::Off => false,
+            BoundaryWalls::Unmarked => !self.marks_its_walls(),
+            BoundaryWalls::Always => !self.cells.is_empty(),
+        };
+        wanted.then(|| {
+            let mut g = grid.clone();
+            for &(x, y) in &self.cells {
+                g.set(x, y, ROS_LOGODDS_LIMIT);
+            }
+            g
+        })
+    }
+}
+
+/// Whether `grid` marks its walls ([`Boundary::marks_its_walls`]).
 pub fn marks_its_walls(grid: &OccupancyGrid) -> bool {
-    let boundary = boundary_cells(grid).len();
-    let (_, occupied, _) = grid.state_counts();
-    boundary == 0 || occupied as f64 >= BOUNDARY_STYLE_RATIO * boundary as f64
+    Boundary::of(grid).marks_its_walls()
 }
 
 /// `grid` with walls where its free space meets unknown, when it does not mark its walls (fewer occupied cells than
 /// [`BOUNDARY_STYLE_RATIO`] of its boundary cells); `None` when it does (use it as it is).
 pub fn walls_from_boundary(grid: &OccupancyGrid) -> Option<OccupancyGrid> {
-    with_boundary_walls(grid, BoundaryWalls::Unmarked)
-}
-
-/// `grid` with walls where its free space meets unknown when `mode` asks for them; `None`: use it as it is.
-pub fn with_boundary_walls(grid: &OccupancyGrid, mode: BoundaryWalls) -> Option<OccupancyGrid> {
-    if mode == BoundaryWalls::Off {
-        return None;
-    }
-    let boundary = boundary_cells(grid);
-    let (_, occupied, _) = grid.state_counts();
-    let marked = occupied as f64 >= BOUNDARY_STYLE_RATIO * boundary.len() as f64;
-    if boundary.is_empty() || (mode == BoundaryWalls::Unmarked && marked) {
-        return None;
-    }
-    let mut g = grid.clone();
-    for (x, y) in boundary {
-        g.set(x, y, ROS_LOGODDS_LIMIT);
-    }
-    Some(g)
+    Boundary::of(grid).walls(grid, BoundaryWalls::Unmarked)
 }
 
 #[cfg(test)]

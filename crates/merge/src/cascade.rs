@@ -12,8 +12,8 @@
 //! Each stage is a second chance for a wrong pose too, so the order and the stages were chosen by measuring false
 //! merges on non-overlapping pairs alongside the successes (benchmarks/runs/2026-12-02-merge-cascade.md).
 
-use crate::boundary_walls::{BoundaryWalls, marks_its_walls};
-use crate::merger::{Alignment, MergeOutcome, MergeParams, Merger, NoAlignment, merge_one};
+use crate::boundary_walls::{Boundary, BoundaryWalls};
+use crate::merger::{Alignment, MergeOutcome, MergeParams, Merger, NoAlignment, merge_bounded, refused};
 use crate::{CorrelativeMerger, CorrelativeParams, SiftMerger, SiftMergerParams};
 use mrslam_core::OccupancyGrid;
 use std::collections::BTreeMap;
@@ -93,7 +93,14 @@ impl Merger for Cascade {
                 Err(no) => last = Some(no),
             }
         }
-        Err(last.unwrap_or_else(no_stages))
+        Err(last.unwrap_or_else(|| {
+            Box::new(NoAlignment {
+                reason: NO_STAGES.into(),
+                matches: 0,
+                timings_ms: BTreeMap::new(),
+                evidence: Default::default(),
+            })
+        }))
     }
 
     fn cascade(&self) -> Option<&Cascade> {
@@ -109,8 +116,10 @@ pub(crate) fn merge_cascade(c: &Cascade, a: &OccupancyGrid, b: &OccupancyGrid, p
     let mut timings = BTreeMap::new();
     let mut reasons = Vec::new();
     let mut last: Option<MergeOutcome> = None;
-    for (stage, params) in c.active(p, marks_its_walls(a) || marks_its_walls(b)) {
-        let mut out = merge_one(stage.merger.as_ref(), a, b, &params);
+    // Each map's boundary found once for every stage (its walls, whether it marks them).
+    let (ba, bb) = (Boundary::of(a), Boundary::of(b));
+    for (stage, params) in c.active(p, ba.marks_its_walls() || bb.marks_its_walls()) {
+        let mut out = merge_bounded(stage.merger.as_ref(), (a, b), Some((&ba, &bb)), &params, Instant::now());
         for (k, v) in std::mem::take(&mut out.report.timings_ms) {
             timings.insert(format!("{}/{k}", stage.name), v);
         }
@@ -124,7 +133,7 @@ pub(crate) fn merge_cascade(c: &Cascade, a: &OccupancyGrid, b: &OccupancyGrid, p
         last = Some(out);
     }
     let Some(mut out) = last else {
-        return merge_one(&NoStages, a, b, p);
+        return refused(c, NO_STAGES.into(), 0, BTreeMap::new(), start);
     };
     if !out.report.accepted {
         out.report.reason = Some(reasons.join("; "));
@@ -135,31 +144,13 @@ pub(crate) fn merge_cascade(c: &Cascade, a: &OccupancyGrid, b: &OccupancyGrid, p
     out
 }
 
-/// What an empty cascade aligns with: nothing.
-struct NoStages;
-
 /// Why an empty cascade finds nothing.
-fn no_stages() -> Box<NoAlignment> {
-    Box::new(NoAlignment {
-        reason: "a cascade without stages".into(),
-        matches: 0,
-        timings_ms: BTreeMap::new(),
-        evidence: Default::default(),
-    })
-}
-
-impl Merger for NoStages {
-    fn name(&self) -> &'static str {
-        crate::Algorithm::Cascade.name()
-    }
-    fn align(&self, _: &OccupancyGrid, _: &OccupancyGrid) -> Result<Alignment, Box<NoAlignment>> {
-        Err(no_stages())
-    }
-}
+const NO_STAGES: &str = "a cascade without stages";
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::boundary_walls::marks_its_walls;
     use crate::merger::tests::{Fixed, room};
     use mrslam_core::{Pose2, pose};
 

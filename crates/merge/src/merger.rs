@@ -1,6 +1,6 @@
 //! The merge pipeline shared by every algorithm: align, verify, fuse, report.
 
-use crate::boundary_walls::BoundaryWalls;
+use crate::boundary_walls::{Boundary, BoundaryWalls};
 use crate::fuse::{FusionRule, fuse};
 use crate::refine::{RefineParams, refine, wall_points};
 use crate::report::MergeReport;
@@ -250,19 +250,19 @@ pub fn merge(merger: &dyn Merger, a: &OccupancyGrid, b: &OccupancyGrid, p: &Merg
 }
 
 /// Why a map that does not mark its walls cannot go to an algorithm that needs them; None when it does.
-fn unmarked_walls(g: &OccupancyGrid, name: &str) -> Option<String> {
-    (!crate::boundary_walls::marks_its_walls(g)).then(|| {
-        let (_, occupied, _) = g.state_counts();
+fn unmarked_walls(boundary: &Boundary, name: &str) -> Option<String> {
+    (!boundary.marks_its_walls()).then(|| {
         format!(
-            "map {name} does not mark its walls ({occupied} occupied cells): its walls would be its free/unknown \
-             boundary, where a frontier looks like a wall, and this search scores the other map's free space \
-             against them; the sift merger takes such maps"
+            "map {name} does not mark its walls ({} occupied cells): its walls would be its free/unknown boundary, \
+             where a frontier looks like a wall, and this search scores the other map's free space against them; \
+             the sift merger takes such maps",
+            boundary.occupied()
         )
     })
 }
 
 /// The outcome of a merge refused before the gate: no transform, no merged map.
-fn refused(
+pub(crate) fn refused(
     merger: &dyn Merger,
     reason: String,
     matches: usize,
@@ -292,15 +292,31 @@ fn refused(
 /// [`merge`] for one algorithm.
 pub(crate) fn merge_one(merger: &dyn Merger, a: &OccupancyGrid, b: &OccupancyGrid, p: &MergeParams) -> MergeOutcome {
     let start = Instant::now();
+    let needed = p.boundary_walls != BoundaryWalls::Off || merger.needs_marked_walls();
+    let boundaries = needed.then(|| (Boundary::of(a), Boundary::of(b)));
+    merge_bounded(merger, (a, b), boundaries.as_ref().map(|(x, y)| (x, y)), p, start)
+}
+
+/// [`merge_one`] with the maps' boundaries found already (None: neither the mode nor the algorithm needs them); the
+/// merge's time counts from `start`.
+pub(crate) fn merge_bounded(
+    merger: &dyn Merger,
+    (a, b): (&OccupancyGrid, &OccupancyGrid),
+    boundaries: Option<(&Boundary, &Boundary)>,
+    p: &MergeParams,
+    start: Instant,
+) -> MergeOutcome {
     if merger.needs_marked_walls()
-        && let Some(reason) = unmarked_walls(a, "a").or_else(|| unmarked_walls(b, "b"))
+        && let Some(reason) = boundaries.and_then(|(x, y)| unmarked_walls(x, "a").or_else(|| unmarked_walls(y, "b")))
     {
         return refused(merger, reason, 0, BTreeMap::new(), start);
     }
     // Maps that do not mark their walls get them from their free/unknown boundary; the fusion takes the maps as given.
     let (given_a, given_b) = (a, b);
-    let walled = |g: &OccupancyGrid| crate::boundary_walls::with_boundary_walls(g, p.boundary_walls);
-    let (walled_a, walled_b) = (walled(a), walled(b));
+    let (walled_a, walled_b) = match boundaries {
+        Some((x, y)) => (x.walls(a, p.boundary_walls), y.walls(b, p.boundary_walls)),
+        None => (None, None),
+    };
     let (a, b) = (walled_a.as_ref().unwrap_or(a), walled_b.as_ref().unwrap_or(b));
     let alignment = match merger.align(a, b) {
         Ok(al) => al,

@@ -23,7 +23,8 @@ const COLOURS: [RGBColor; 6] = [
     RGBColor(140, 86, 75),
 ];
 
-fn register() {
+/// Registers the compiled-in font as plotters' "sans-serif", once per process (every plot of the tools uses it).
+pub fn register_sans_serif() {
     static ONCE: Once = Once::new();
     ONCE.call_once(|| {
         // The font is valid (it ships with egui); should it ever not be, text is dropped, not the plot.
@@ -33,7 +34,7 @@ fn register() {
 
 /// Draws the summary into an RGB buffer of [`WIDTH`] × [`HEIGHT`].
 pub fn render(summary: &[SummaryRow]) -> Result<Vec<u8>, String> {
-    register();
+    register_sans_serif();
     let mut buf = vec![255u8; (WIDTH * HEIGHT * 3) as usize];
     {
         let root = BitMapBackend::with_buffer(&mut buf, (WIDTH, HEIGHT)).into_drawing_area();
@@ -145,7 +146,12 @@ pub fn render(summary: &[SummaryRow]) -> Result<Vec<u8>, String> {
 /// Draws the summary into `path` as a PNG of [`WIDTH`] × [`HEIGHT`].
 pub fn draw(summary: &[SummaryRow], path: &Path) -> Result<(), StudyError> {
     let buf = render(summary).map_err(|e| StudyError::file(path, format!("drawing the plot: {e}")))?;
-    let img = image::RgbImage::from_raw(WIDTH, HEIGHT, buf)
+    write_rgb_png(buf, (WIDTH, HEIGHT), path)
+}
+
+/// Writes an RGB buffer of `size` pixels as a PNG at `path` (under a temporary name, then renamed).
+pub fn write_rgb_png(buf: Vec<u8>, size: (u32, u32), path: &Path) -> Result<(), StudyError> {
+    let img = image::RgbImage::from_raw(size.0, size.1, buf)
         .ok_or_else(|| StudyError::file(path, "plot buffer of the wrong size"))?;
     let mut bytes = Vec::new();
     img.write_to(&mut std::io::Cursor::new(&mut bytes), image::ImageFormat::Png)

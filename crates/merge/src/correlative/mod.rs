@@ -325,6 +325,50 @@ pub fn significance(merger: &CorrelativeMerger, a: &OccupancyGrid, b: &Occupancy
     merger.settled(a, b, &mut BTreeMap::new()).ok().map(|c| c.significance)
 }
 
+/// Both maps pooled to one search resolution, built once per pair and resolution: a's block states and b's wall
+/// blocks as a scan (both searches of a pair share them).
+struct Pooled {
+    /// The search cell, metres (a whole number of a's cells).
+    cell: f64,
+    /// a's states on search cells.
+    blocks: BlockStates,
+    /// b's wall blocks, thinned to [`CorrelativeParams::max_points`].
+    scan: WallScan,
+}
+
+impl Pooled {
+    fn build(a: &OccupancyGrid, b: &OccupancyGrid, resolution: f64, max_points: usize) -> Self {
+        let fa = ((resolution / a.resolution()).round() as usize).max(1);
+        let fb = ((resolution / b.resolution()).round() as usize).max(1);
+        Pooled {
+            cell: fa as f64 * a.resolution(),
+            blocks: BlockStates::of(a, fa),
+            scan: WallScan::of_blocks(b, fb, max_points),
+        }
+    }
+}
+
+/// What the fine stage scores on, built once per pair: b's wall points at its own resolution (thinned to
+/// [`CorrelativeParams::max_fine_points`] in the scan) and the score field of a at a's resolution.
+struct FineField {
+    /// Every wall point of b (b's frame), for wall ICP.
+    points: Vec<Point2<f64>>,
+    /// The same thinned, about their centroid.
+    scan: WallScan,
+    /// a's fine score field, max-pooled [`FINE_DEPTH`] levels for the windows' branch and bound.
+    pyramid: Pyramid,
+}
+
+impl FineField {
+    fn build(a: &OccupancyGrid, b: &OccupancyGrid, p: &CorrelativeParams) -> Self {
+        let points = wall_points(b);
+        let scan = WallScan::of_points(&points, p.max_fine_points);
+        let penalty = (p.fine_free_penalty.max(0.0) * f64::from(HIT)).round() as i16;
+        let field = ScoreField::build(&BlockStates::of(a, 1), p.fine_sigma_cells, penalty);
+        FineField { points, scan, pyramid: Pyramid::build(&field, FINE_DEPTH) }
+    }
+}
+
 /// The global search's answers refined on the fine field, strongest first, and the significance of the first.
 struct Candidates {
     /// Polished poses `T_a_b` and their fine scores, strongest first.
@@ -410,19 +454,14 @@ impl CorrelativeMerger {
     fn global(
         &self,
         a: &OccupancyGrid,
-        b: &OccupancyGrid,
-        resolution: f64,
+        pooled: &Pooled,
         keep: usize,
+        peaks: &[f64],
         timings: &mut BTreeMap<String, f64>,
     ) -> Result<Found, Box<NoAlignment>> {
         let p = &self.params;
-        let t = Instant::now();
-        let fa = ((resolution / a.resolution()).round() as usize).max(1);
-        let fb = ((resolution / b.resolution()).round() as usize).max(1);
-        let cell = fa as f64 * a.resolution();
-        let blocks = BlockStates::of(a, fa);
-        let scan = WallScan::of_blocks(b, fb, p.max_points);
-        timings.insert("pool".into(), ms(t));
+        let Pooled { cell, blocks, scan } = pooled;
+        let cell = *cell;
         if scan.points.len() < p.min_points {
             return Err(fail(
                 format!("too few walls in map b: {} blocks (need {})", scan.points.len(), p.min_points),
@@ -431,7 +470,7 @@ impl CorrelativeMerger {
         }
         let t = Instant::now();
         let penalty = (p.free_penalty.max(0.0) * f64::from(HIT)).round() as i16;
-        let field = ScoreField::build(&blocks, p.sigma_cells, penalty);
+        let field = ScoreField::build(blocks, p.sigma_cells, penalty);
         if !field.values.contains(&HIT) {
             return Err(fail("map a has no walls".into(), timings.clone()));
         }
@@ -441,12 +480,8 @@ impl CorrelativeMerger {
         let step = (p.angle_step_scale * cell / scan.radius.max(cell)).min(PI / 2.0);
         let n_rot = (TAU / step).ceil() as usize;
         let step = TAU / n_rot as f64;
-        let t_prior = Instant::now();
-        let peaks =
-            if p.rotation_prior { orientation::rotation_peaks(a, b, p.rotation_peak_ratio) } else { Vec::new() };
         let tolerance = p.rotation_tolerance_deg.to_radians().max(step);
-        let searched = |j: usize| peaks.is_empty() || orientation::near_a_peak(j as f64 * step, &peaks, tolerance);
-        timings.insert("orientation".into(), ms(t_prior));
+        let searched = |j: usize| peaks.is_empty() || orientation::near_a_peak(j as f64 * step, peaks, tolerance);
         let min_floor = (p.min_score * f64::from(HIT) * scan.points.len() as f64).ceil() as i64;
         let separation = ((p.distinct_m / cell).ceil() as i32).max(1);
         let one = |scratch: &mut (Vec<(i32, i32)>, Vec<Candidate>), j: usize, floor: i64| -> Vec<Global> {
@@ -535,20 +570,13 @@ impl CorrelativeMerger {
     fn candidates(
         &self,
         a: &OccupancyGrid,
-        b: &OccupancyGrid,
+        fine_field: &FineField,
         searches: &[&Found],
         timings: &mut BTreeMap<String, f64>,
     ) -> Candidates {
         let p = &self.params;
         let t = Instant::now();
-        let fine_points = wall_points(b);
-        let scan = WallScan::of_points(&fine_points, p.max_fine_points);
-        let fine = ScoreField::build(
-            &BlockStates::of(a, 1),
-            p.fine_sigma_cells,
-            (p.fine_free_penalty.max(0.0) * f64::from(HIT)).round() as i16,
-        );
-        let fine = Pyramid::build(&fine, FINE_DEPTH);
+        let FineField { points: fine_points, scan, pyramid: fine } = fine_field;
         let coarse_cells = ((p.search_resolution / a.resolution()).round() as i32).max(1);
         let window = LocalWindow {
             cells: coarse_cells + 1,
@@ -557,7 +585,7 @@ impl CorrelativeMerger {
         };
         let one = |buf: &mut Vec<(i32, i32)>, (i, t_a_b): (usize, &Pose2)| {
             let start = to_scan_pose(a, &scan.centroid, t_a_b);
-            let (q, s) = local_search(&fine, a.resolution(), &scan, start, &window, buf);
+            let (q, s) = local_search(fine, a.resolution(), scan, start, &window, buf);
             (i, q, s)
         };
         // Every global answer and rival refined: the fine field ranks them (the coarse search only screens).
@@ -589,9 +617,9 @@ impl CorrelativeMerger {
             .iter()
             .take(p.polished.max(1))
             .map(|(i, q, _)| {
-                let t = refine(a, &fine_points, &transform(q), &icp);
+                let t = refine(a, fine_points, &transform(q), &icp);
                 let (_, s) =
-                    local_search(&fine, a.resolution(), &scan, to_scan_pose(a, &scan.centroid, &t), &window0, &mut buf);
+                    local_search(fine, a.resolution(), scan, to_scan_pose(a, &scan.centroid, &t), &window0, &mut buf);
                 (*i, t, s)
             })
             .collect();
@@ -599,7 +627,7 @@ impl CorrelativeMerger {
         let from_first = searches.first().map_or(0, |f| f.poses.len() + f.rivals.len());
         let best_from_first = polished[0].0 < from_first;
         // The significance test: the best polished answer against every one clearly apart from it.
-        let moved = |t: &Pose2, u: &Pose2| max_displacement(&scan, t, u);
+        let moved = |t: &Pose2, u: &Pose2| max_displacement(scan, t, u);
         let (best, best_score) = (polished[0].1, polished[0].2);
         let rival = polished[1..].iter().find(|r| moved(&r.1, &best) > p.rival_distinct_m);
         let significance =
@@ -624,8 +652,18 @@ impl CorrelativeMerger {
         timings: &mut BTreeMap<String, f64>,
     ) -> Result<Candidates, Box<NoAlignment>> {
         let p = &self.params;
-        let strict = self.search(a, b, timings)?;
-        let first = self.candidates(a, b, &[&strict], timings);
+        let t = Instant::now();
+        let pooled = Pooled::build(a, b, p.search_resolution, p.max_points);
+        timings.insert("pool".into(), ms(t));
+        let t = Instant::now();
+        let peaks =
+            if p.rotation_prior { orientation::rotation_peaks(a, b, p.rotation_peak_ratio) } else { Vec::new() };
+        timings.insert("orientation".into(), ms(t));
+        let strict = self.search(a, b, &pooled, &peaks, timings)?;
+        let t = Instant::now();
+        let fine = FineField::build(a, b, p);
+        timings.insert("fine_field".into(), ms(t));
+        let first = self.candidates(a, &fine, &[&strict], timings);
         let settles = |c: &Candidates| {
             c.significance.refusal(p.min_margin).is_none()
                 && !self.shared(a, b, &c.refined, c.min_overlap_m2).0.is_empty()
@@ -643,13 +681,13 @@ impl CorrelativeMerger {
             ..*p
         });
         let mut more = BTreeMap::new();
-        let Ok(second) = tolerant.search(a, b, &mut more) else {
+        let Ok(second) = tolerant.search(a, b, &pooled, &peaks, &mut more) else {
             return Ok(first);
         };
         for (k, v) in more {
             timings.insert(format!("fallback_{k}"), v);
         }
-        let mut pooled = self.candidates(a, b, &[&strict, &second], timings);
+        let mut pooled = self.candidates(a, &fine, &[&strict, &second], timings);
         // A pose only the tolerant search found needs the larger shared area; the first search's settled answer,
         // now tested against the tolerant search's rivals too, keeps its own.
         if !first_settles || !pooled.best_from_first {
@@ -697,21 +735,24 @@ impl CorrelativeMerger {
         &self,
         a: &OccupancyGrid,
         b: &OccupancyGrid,
+        pooled: &Pooled,
+        peaks: &[f64],
         timings: &mut BTreeMap<String, f64>,
     ) -> Result<Found, Box<NoAlignment>> {
         let p = &self.params;
         if p.screen_resolution < 1.5 * p.search_resolution {
-            return self.global(a, b, p.search_resolution, p.hypotheses, timings);
+            return self.global(a, pooled, p.hypotheses, peaks, timings);
         }
-        let coarse = self.global(a, b, p.screen_resolution, p.screen_candidates, timings)?;
+        let t = Instant::now();
+        let screen = Pooled::build(a, b, p.screen_resolution, p.max_points);
+        timings.insert("pool_screen".into(), ms(t));
+        let coarse = self.global(a, &screen, p.screen_candidates, peaks, timings)?;
         // Each screened answer searched again around itself at the search resolution.
         let t = Instant::now();
-        let fa = ((p.search_resolution / a.resolution()).round() as usize).max(1);
-        let fb = ((p.search_resolution / b.resolution()).round() as usize).max(1);
-        let cell = fa as f64 * a.resolution();
-        let scan = WallScan::of_blocks(b, fb, p.max_points);
+        let Pooled { cell, blocks, scan } = pooled;
+        let cell = *cell;
         let penalty = (p.free_penalty.max(0.0) * f64::from(HIT)).round() as i16;
-        let field = Pyramid::build(&ScoreField::build(&BlockStates::of(a, fa), p.sigma_cells, penalty), 0);
+        let field = Pyramid::build(&ScoreField::build(blocks, p.sigma_cells, penalty), 0);
         let step = (p.angle_step_scale * cell / scan.radius.max(cell)).min(PI / 2.0);
         let window = LocalWindow {
             cells: (p.screen_resolution / cell).ceil() as i32 + 1,
@@ -725,7 +766,7 @@ impl CorrelativeMerger {
             .enumerate()
             .map(|(i, t_a_b)| {
                 let start = to_scan_pose(a, &scan.centroid, t_a_b);
-                let (q, s) = local_search(&field, cell, &scan, start, &window, &mut buf);
+                let (q, s) = local_search(&field, cell, scan, start, &window, &mut buf);
                 (i, q, s)
             })
             .collect();
