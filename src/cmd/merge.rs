@@ -153,6 +153,9 @@ pub fn run(args: MergeArgs) -> Result<ExitCode> {
         wall_dilation: args.wall_dilation as usize,
         hypotheses: args.hypotheses as usize,
         encoding: if args.encoding == "paper" { MapEncoding::PAPER } else { MapEncoding::WALLS },
+        // One merge has the machine to itself: the two maps' features on two threads (the studies, which run
+        // merges side by side, keep one thread per merge).
+        parallel: true,
         ..Default::default()
     };
     params.ransac.seed = args.seed;

@@ -12,7 +12,7 @@
 //! for each such rotation, step = cell / radius (rayon): (Olson 2009; Cartographer's angular step)
 //!     branch and bound over all translations           search::branch_and_bound
 //! best distinct (rotation, translation) overall        hypotheses, strongest first, and rivals
-//! each: a window at a's resolution (branch and bound; rayon) local::local_search
+//! each: a window at a's resolution (every offset; rayon)   local::local_search
 //! the strongest: wall ICP, scored again, ranked        refine::refine
 //! significance: best against the best 2 m or more away Significance (Lowe's ratio test)
 //! a second search with a softer penalty, pooled:      fallback_free_penalty (rivals; its own winner
@@ -40,7 +40,7 @@ use crate::merger::{Alignment, Evidence, Hypothesis, Merger, NoAlignment};
 use crate::refine::{RefineParams, refine, wall_points};
 use crate::verify::{agreement, wall_hits};
 use field::{BlockStates, HIT, ScoreField};
-use local::{LocalWindow, ScanPose, local_search};
+use local::{LocalScratch, LocalWindow, ScanPose, WindowField, local_search};
 use mrslam_core::{OccupancyGrid, Pose2, pose};
 use nalgebra::{Point2, Rotation2};
 use pyramid::Pyramid;
@@ -227,10 +227,6 @@ impl CorrelativeMerger {
     }
 }
 
-/// Levels of the fine field's max-pooled pyramid: its windows (a search cell and one more either side, 19 cells
-/// at 0.4 m over 5 cm) start as 8-cell blocks.
-const FINE_DEPTH: usize = 3;
-
 /// The rounds of the rotation search, as (modulus, remainder) of the rotation index: every 16th first.
 const ROUNDS: [(usize, usize); 5] = [(16, 0), (16, 8), (8, 4), (4, 2), (2, 1)];
 
@@ -355,8 +351,8 @@ struct FineField {
     points: Vec<Point2<f64>>,
     /// The same thinned, about their centroid.
     scan: WallScan,
-    /// a's fine score field, max-pooled [`FINE_DEPTH`] levels for the windows' branch and bound.
-    pyramid: Pyramid,
+    /// a's fine score field, laid out for the windows.
+    field: WindowField,
 }
 
 impl FineField {
@@ -365,8 +361,22 @@ impl FineField {
         let scan = WallScan::of_points(&points, p.max_fine_points);
         let penalty = (p.fine_free_penalty.max(0.0) * f64::from(HIT)).round() as i16;
         let field = ScoreField::build(&BlockStates::of(a, 1), p.fine_sigma_cells, penalty);
-        FineField { points, scan, pyramid: Pyramid::build(&field, FINE_DEPTH) }
+        FineField { points, scan, field: WindowField::new(&field, fine_window_cells(a, p) as usize) }
     }
+}
+
+/// The fine stage's work on one pair kept between its calls: each start's refinement and polish, by its index
+/// among the starts, for one window.
+#[derive(Debug, Default)]
+struct FineCache {
+    window: Option<LocalWindow>,
+    refined: Vec<(ScanPose, i64)>,
+    polished: BTreeMap<usize, (Pose2, i64)>,
+}
+
+/// Offsets the fine windows search either side of a global answer, cells of a: a search cell and one more.
+fn fine_window_cells(a: &OccupancyGrid, p: &CorrelativeParams) -> i32 {
+    ((p.search_resolution / a.resolution()).round() as i32).max(1) + 1
 }
 
 /// The global search's answers refined on the fine field, strongest first, and the significance of the first.
@@ -398,17 +408,17 @@ pub fn score_near(
     let scan = WallScan::of_blocks(b, fb, p.max_points);
     let penalty = (p.free_penalty.max(0.0) * f64::from(HIT)).round() as i16;
     let field = ScoreField::build(&BlockStates::of(a, fa), p.sigma_cells, penalty);
-    let grid = Pyramid::build(&field, 0);
+    let grid = WindowField::new(&field, 2);
     let step = (p.angle_step_scale * cell / scan.radius.max(cell)).min(PI / 2.0);
     let window = LocalWindow { cells: 2, angles: 2, angle_step: step };
     let start = to_scan_pose(a, &scan.centroid, t_a_b);
     let mut pts = Vec::new();
-    let (q, s) = local_search(&grid, cell, &scan, start, &window, &mut pts);
+    let (q, s) = local_search(&grid, cell, &scan, start, &window, &mut LocalScratch::default());
     scan.discretize(q.theta, cell, &mut pts);
     let (cx, cy) = ((q.tx / cell - 0.5).round() as i32, (q.ty / cell - 0.5).round() as i32);
     let mut counts = [0usize; 3];
     for &(x, y) in &pts {
-        let v = grid.levels[0].get(x + cx, y + cy);
+        let v = grid.get(x + cx, y + cy);
         counts[if v > 0 {
             0
         } else if v < 0 {
@@ -504,9 +514,9 @@ impl CorrelativeMerger {
         for (modulus, rest) in ROUNDS {
             let js: Vec<usize> = (0..n_rot).filter(|&j| j % modulus == rest && searched(j)).collect();
             let found: Vec<Vec<Global>> = if p.parallel {
-                js.par_iter().map_init(|| (Vec::new(), Vec::new()), |s, &j| one(s, j, floor)).collect()
+                js.par_iter().map_init(Default::default, |s, &j| one(s, j, floor)).collect()
             } else {
-                let mut scratch = (Vec::new(), Vec::new());
+                let mut scratch = Default::default();
                 js.iter().map(|&j| one(&mut scratch, j, floor)).collect()
             };
             all.extend(found.into_iter().flatten());
@@ -565,25 +575,31 @@ impl CorrelativeMerger {
         })
     }
 
-    /// The global answers and the significance test's rivals, each refined by an exhaustive search of a small
-    /// window on the fine field (a's resolution); the refined answers strongest first.
+    /// The global answers and the significance test's rivals, each refined by a search of a small window on the
+    /// fine field (a's resolution); the refined answers strongest first.
+    ///
+    /// `cache` keeps each start's refinement and polish by its index among the starts: a second call whose
+    /// searches begin with the first call's (the fallback pooled with the strict search) reuses them.
     fn candidates(
         &self,
         a: &OccupancyGrid,
         fine_field: &FineField,
         searches: &[&Found],
+        cache: &mut FineCache,
         timings: &mut BTreeMap<String, f64>,
     ) -> Candidates {
         let p = &self.params;
         let t = Instant::now();
-        let FineField { points: fine_points, scan, pyramid: fine } = fine_field;
-        let coarse_cells = ((p.search_resolution / a.resolution()).round() as i32).max(1);
+        let FineField { points: fine_points, scan, field: fine } = fine_field;
         let window = LocalWindow {
-            cells: coarse_cells + 1,
+            cells: fine_window_cells(a, p),
             angles: p.fine_angles,
             angle_step: searches.iter().map(|f| f.step).fold(f64::INFINITY, f64::min) / p.fine_angles.max(1) as f64,
         };
-        let one = |buf: &mut Vec<(i32, i32)>, (i, t_a_b): (usize, &Pose2)| {
+        if cache.window != Some(window) {
+            *cache = FineCache { window: Some(window), ..FineCache::default() };
+        }
+        let one = |buf: &mut LocalScratch, (i, t_a_b): (usize, &Pose2)| {
             let start = to_scan_pose(a, &scan.centroid, t_a_b);
             let (q, s) = local_search(fine, a.resolution(), scan, start, &window, buf);
             (i, q, s)
@@ -591,13 +607,18 @@ impl CorrelativeMerger {
         // Every global answer and rival refined: the fine field ranks them (the coarse search only screens).
         let starts: Vec<(usize, &Pose2)> =
             searches.iter().flat_map(|f| f.poses.iter().chain(&f.rivals)).enumerate().collect();
-        let mut refined: Vec<(usize, ScanPose, i64)> = if p.parallel {
-            starts.par_iter().map_init(Vec::new, |buf, &s| one(buf, s)).collect()
+        let known = cache.refined.len().min(starts.len());
+
+        let fresh: Vec<(usize, ScanPose, i64)> = if p.parallel {
+            starts[known..].par_iter().map_init(LocalScratch::default, |buf, &s| one(buf, s)).collect()
         } else {
-            let mut buf = Vec::new();
-            starts.iter().map(|&s| one(&mut buf, s)).collect()
+            let mut buf = LocalScratch::default();
+            starts[known..].iter().map(|&s| one(&mut buf, s)).collect()
         };
-        let mut buf = Vec::new();
+        cache.refined.extend(fresh.iter().map(|&(_, q, s)| (q, s)));
+        let mut refined: Vec<(usize, ScanPose, i64)> =
+            cache.refined[..starts.len()].iter().enumerate().map(|(i, &(q, s))| (i, q, s)).collect();
+        let mut buf = LocalScratch::default();
         refined.sort_by(|x, y| y.2.cmp(&x.2).then(x.0.cmp(&y.0)));
         let apart =
             |q: &ScanPose, k: &ScanPose| (q.tx - k.tx).hypot(q.ty - k.ty) + scan.radius * angle_gap(q.theta, k.theta);
@@ -617,9 +638,11 @@ impl CorrelativeMerger {
             .iter()
             .take(p.polished.max(1))
             .map(|(i, q, _)| {
-                let t = refine(a, fine_points, &transform(q), &icp);
-                let (_, s) =
-                    local_search(fine, a.resolution(), scan, to_scan_pose(a, &scan.centroid, &t), &window0, &mut buf);
+                let (t, s) = *cache.polished.entry(*i).or_insert_with(|| {
+                    let t = refine(a, fine_points, &transform(q), &icp);
+                    let start = to_scan_pose(a, &scan.centroid, &t);
+                    (t, local_search(fine, a.resolution(), scan, start, &window0, &mut buf).1)
+                });
                 (*i, t, s)
             })
             .collect();
@@ -663,7 +686,8 @@ impl CorrelativeMerger {
         let t = Instant::now();
         let fine = FineField::build(a, b, p);
         timings.insert("fine_field".into(), ms(t));
-        let first = self.candidates(a, &fine, &[&strict], timings);
+        let mut cache = FineCache::default();
+        let first = self.candidates(a, &fine, &[&strict], &mut cache, timings);
         let settles = |c: &Candidates| {
             c.significance.refusal(p.min_margin).is_none()
                 && !self.shared(a, b, &c.refined, c.min_overlap_m2).0.is_empty()
@@ -687,7 +711,7 @@ impl CorrelativeMerger {
         for (k, v) in more {
             timings.insert(format!("fallback_{k}"), v);
         }
-        let mut pooled = self.candidates(a, &fine, &[&strict, &second], timings);
+        let mut pooled = self.candidates(a, &fine, &[&strict, &second], &mut cache, timings);
         // A pose only the tolerant search found needs the larger shared area; the first search's settled answer,
         // now tested against the tolerant search's rivals too, keeps its own.
         if !first_settles || !pooled.best_from_first {
@@ -752,14 +776,11 @@ impl CorrelativeMerger {
         let Pooled { cell, blocks, scan } = pooled;
         let cell = *cell;
         let penalty = (p.free_penalty.max(0.0) * f64::from(HIT)).round() as i16;
-        let field = Pyramid::build(&ScoreField::build(blocks, p.sigma_cells, penalty), 0);
         let step = (p.angle_step_scale * cell / scan.radius.max(cell)).min(PI / 2.0);
-        let window = LocalWindow {
-            cells: (p.screen_resolution / cell).ceil() as i32 + 1,
-            angles: (coarse.step / step).ceil() as usize,
-            angle_step: step,
-        };
-        let mut buf = Vec::new();
+        let cells = (p.screen_resolution / cell).ceil() as i32 + 1;
+        let field = WindowField::new(&ScoreField::build(blocks, p.sigma_cells, penalty), cells as usize);
+        let window = LocalWindow { cells, angles: (coarse.step / step).ceil() as usize, angle_step: step };
+        let mut buf = LocalScratch::default();
         let mut found: Vec<(usize, ScanPose, i64)> = coarse
             .poses
             .iter()
