@@ -22,7 +22,7 @@ if len(args.maps) % 2:
     sys.exit("maps come in pairs: A1 B1 A2 B2 ...")
 here = os.path.dirname(os.path.abspath(__file__))
 ratios = []
-print(f"{'pair':<40} {'mrslam ms':>10} {'opencv ms':>10} {'ratio':>6}  decided by")
+print(f"{'pair':<52} {'mrslam ms':>10} {'opencv ms':>10} {'ratio':>6}  decided by")
 with tempfile.TemporaryDirectory() as tmp:
     for a, b in zip(args.maps[::2], args.maps[1::2]):
         times, stage, accepted = [], "", False
@@ -38,7 +38,8 @@ with tempfile.TemporaryDirectory() as tmp:
         cv = float(re.search(r"total ([0-9.]+)", out).group(1))
         ours = statistics.median(times)
         ratios.append(ours / cv)
-        name = f"{os.path.basename(a)} {os.path.basename(b)}"
+        short = lambda m: os.path.join(os.path.basename(os.path.dirname(os.path.abspath(m))), os.path.basename(m))
+        name = f"{short(a)} {short(b)}"
         verdict = stage if accepted else f"refused ({stage})"
-        print(f"{name:<40} {ours:>10.1f} {cv:>10.1f} {ours / cv:>6.2f}  {verdict}", flush=True)
+        print(f"{name:<52} {ours:>10.1f} {cv:>10.1f} {ours / cv:>6.2f}  {verdict}", flush=True)
 print(f"median ratio {statistics.median(ratios):.2f} over {len(ratios)} pairs (OpenCV on {args.threads} thread(s))")

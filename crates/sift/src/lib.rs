@@ -20,6 +20,7 @@ mod dispatch;
 mod error;
 mod extrema;
 mod fastmath;
+mod huge_pages;
 mod image;
 mod keypoint;
 mod mask;
