@@ -9,7 +9,7 @@ fn root() -> PathBuf {
 }
 
 const COLUMNS: &str = "trial,overlap_target,overlap,seed,algorithm,accepted,success,false_merge,rotation_error_deg,\
-translation_error_m,time_ms,rotation_error_at_end_deg,translation_error_at_end_m";
+translation_error_m,time_ms,rotation_error_at_end_deg,translation_error_at_end_m,stage";
 
 /// A small study: 3 overlaps x 4 trials x (sift, rmap) on 12 m x 10 m floor plans.
 fn small_study(out: &Path, extra: &[&str]) -> Output {

@@ -229,6 +229,7 @@ mod tests {
             time_ms: 1.0,
             rotation_error_at_end_deg: None,
             translation_error_at_end_m: None,
+            stage: String::new(),
         }
     }
 

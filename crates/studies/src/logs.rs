@@ -415,6 +415,7 @@ impl PairRow {
             time_ms: self.time_ms,
             rotation_error_at_end_deg: None,
             translation_error_at_end_m: None,
+            stage: self.stage.clone(),
         }
     }
 }

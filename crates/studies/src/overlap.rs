@@ -190,6 +190,7 @@ fn run_trial(study: &OverlapStudy, map: &OccupancyGrid, t: &TrialSpec) -> Vec<Tr
                 time_ms: out.report.time_ms,
                 rotation_error_at_end_deg: None,
                 translation_error_at_end_m: None,
+                stage: out.report.stage.clone().unwrap_or_default(),
             }
         })
         .collect()

@@ -13,10 +13,10 @@ use std::path::{Path, PathBuf};
 
 /// The header line of `results.csv`.
 pub const HEADER: &str = "trial,overlap_target,overlap,seed,algorithm,accepted,success,false_merge,\
-rotation_error_deg,translation_error_m,time_ms,rotation_error_at_end_deg,translation_error_at_end_m";
+rotation_error_deg,translation_error_m,time_ms,rotation_error_at_end_deg,translation_error_at_end_m,stage";
 
 /// Number of columns of `results.csv`.
-const COLUMNS: usize = 13;
+const COLUMNS: usize = 14;
 
 /// One trial of one algorithm.
 #[derive(Debug, Clone, PartialEq)]
@@ -48,6 +48,8 @@ pub struct TrialRow {
     pub rotation_error_at_end_deg: Option<f64>,
     /// Translation error against that pose, metres.
     pub translation_error_at_end_m: Option<f64>,
+    /// The stage of a cascade that decided (its last stage for a refusal); empty for one algorithm.
+    pub stage: String,
 }
 
 fn opt(v: Option<f64>, digits: usize) -> String {
@@ -58,7 +60,7 @@ impl TrialRow {
     /// The row as a CSV line (no newline). Every column but `time_ms` is a pure function of the trial.
     pub fn to_csv(&self) -> String {
         format!(
-            "{},{},{:.6},{},{},{},{},{},{},{},{:.3},{},{}",
+            "{},{},{:.6},{},{},{},{},{},{},{},{:.3},{},{},{}",
             self.trial,
             self.overlap_target.map_or(String::new(), |v| v.to_string()),
             self.overlap,
@@ -72,6 +74,7 @@ impl TrialRow {
             self.time_ms,
             opt(self.rotation_error_at_end_deg, 6),
             opt(self.translation_error_at_end_m, 6),
+            self.stage,
         )
     }
 
@@ -110,6 +113,7 @@ impl TrialRow {
             time_ms: num(&f, 10, &name)?,
             rotation_error_at_end_deg: opt_num(11)?,
             translation_error_at_end_m: opt_num(12)?,
+            stage: f[13].to_string(),
         })
     }
 }
@@ -217,6 +221,7 @@ mod tests {
             time_ms: 3.25,
             rotation_error_at_end_deg: None,
             translation_error_at_end_m: Some(0.125),
+            stage: "sift+boundary".into(),
         }
     }
 
@@ -224,10 +229,10 @@ mod tests {
     fn rows_round_trip() {
         let r = row(3, "sift");
         let line = r.to_csv();
-        assert_eq!(line, "3,0.05,0.051235,123456789012345,sift,true,false,true,12.500000,,3.250,,0.125000");
+        assert_eq!(line, "3,0.05,0.051235,123456789012345,sift,true,false,true,12.500000,,3.250,,0.125000,sift+boundary");
         let back = TrialRow::from_csv(&line).unwrap();
         assert_eq!(back.to_csv(), line);
-        assert!(TrialRow::from_csv("1,2,3").unwrap_err().contains("13 columns"));
+        assert!(TrialRow::from_csv("1,2,3").unwrap_err().contains("14 columns"));
         assert!(TrialRow::from_csv(&line.replace("true,false", "yes,false")).unwrap_err().contains("accepted"));
     }
 

@@ -165,6 +165,7 @@ mod tests {
             time_ms: t,
             rotation_error_at_end_deg: None,
             translation_error_at_end_m: None,
+            stage: String::new(),
         }
     }
 

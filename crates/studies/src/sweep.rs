@@ -270,6 +270,7 @@ fn run_trial(sweep: &Sweep, scenario: &Scenario, trial: usize) -> Result<Vec<Tri
             time_ms: m.time_ms,
             rotation_error_at_end_deg: m.rotation_error_at_end_deg,
             translation_error_at_end_m: m.translation_error_at_end_m,
+            stage: m.stage.clone().unwrap_or_default(),
         })
         .collect())
 }

@@ -66,6 +66,9 @@ pub struct MergeResult {
     pub time_ms: f64,
     /// Why it was rejected.
     pub reason: Option<String>,
+    /// The stage of a cascade that decided (its last stage for a refusal); none for one algorithm.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stage: Option<String>,
     /// Estimated transform (host ← other).
     pub transform: Option<Xyt>,
     /// True transform (host ← other).

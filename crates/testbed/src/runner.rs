@@ -449,6 +449,7 @@ fn merge_maps(
             merged_map_acceptance: out.merged.as_ref().map(|m| map_acceptance(truth, m, &evaluated.frames[host])),
             time_ms: out.report.time_ms,
             reason: out.report.reason.clone(),
+            stage: out.report.stage.clone(),
             transform: out.report.transform,
             true_transform: Xyt::from_pose(&true_t),
             true_transform_at_end: Xyt::from_pose(&end_t),
