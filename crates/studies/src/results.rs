@@ -229,7 +229,10 @@ mod tests {
     fn rows_round_trip() {
         let r = row(3, "sift");
         let line = r.to_csv();
-        assert_eq!(line, "3,0.05,0.051235,123456789012345,sift,true,false,true,12.500000,,3.250,,0.125000,sift+boundary");
+        assert_eq!(
+            line,
+            "3,0.05,0.051235,123456789012345,sift,true,false,true,12.500000,,3.250,,0.125000,sift+boundary"
+        );
         let back = TrialRow::from_csv(&line).unwrap();
         assert_eq!(back.to_csv(), line);
         assert!(TrialRow::from_csv("1,2,3").unwrap_err().contains("14 columns"));

@@ -40,7 +40,7 @@ use crate::merger::{Alignment, Evidence, Hypothesis, Merger, NoAlignment};
 use crate::refine::{RefineParams, refine, wall_points};
 use crate::verify::{agreement, wall_hits};
 use field::{BlockStates, HIT, ScoreField};
-use local::{LocalScratch, LocalWindow, ScanPose, WindowField, local_search};
+use local::{LocalScratch, LocalWindow, ScanPose, WindowField, local_search, window_key};
 use mrslam_core::{OccupancyGrid, Pose2, pose};
 use nalgebra::{Point2, Rotation2};
 use pyramid::Pyramid;
@@ -365,12 +365,15 @@ impl FineField {
     }
 }
 
-/// The fine stage's work on one pair kept between its calls: each start's refinement and polish, by its index
-/// among the starts, for one window.
+/// A fine window by its start's angle (bits) and cell.
+type WindowKey = (u64, i32, i32);
+
+/// The fine stage's work on one pair kept between its calls, for one window extent: each window's answer, and
+/// each start's polish by its index among the starts.
 #[derive(Debug, Default)]
 struct FineCache {
     window: Option<LocalWindow>,
-    refined: Vec<(ScanPose, i64)>,
+    windows: BTreeMap<WindowKey, (ScanPose, i64)>,
     polished: BTreeMap<usize, (Pose2, i64)>,
 }
 
@@ -578,8 +581,8 @@ impl CorrelativeMerger {
     /// The global answers and the significance test's rivals, each refined by a search of a small window on the
     /// fine field (a's resolution); the refined answers strongest first.
     ///
-    /// `cache` keeps each start's refinement and polish by its index among the starts: a second call whose
-    /// searches begin with the first call's (the fallback pooled with the strict search) reuses them.
+    /// `cache` keeps each window's answer, and each start's polish by its index among the starts: a second call
+    /// whose searches begin with the first call's (the fallback pooled with the strict search) reuses them.
     fn candidates(
         &self,
         a: &OccupancyGrid,
@@ -599,26 +602,32 @@ impl CorrelativeMerger {
         if cache.window != Some(window) {
             *cache = FineCache { window: Some(window), ..FineCache::default() };
         }
-        let one = |buf: &mut LocalScratch, (i, t_a_b): (usize, &Pose2)| {
-            let start = to_scan_pose(a, &scan.centroid, t_a_b);
-            let (q, s) = local_search(fine, a.resolution(), scan, start, &window, buf);
-            (i, q, s)
+        let one = |buf: &mut LocalScratch, &(key, start): &(WindowKey, ScanPose)| {
+            (key, local_search(fine, a.resolution(), scan, start, &window, buf))
         };
         // Every global answer and rival refined: the fine field ranks them (the coarse search only screens).
-        let starts: Vec<(usize, &Pose2)> =
-            searches.iter().flat_map(|f| f.poses.iter().chain(&f.rivals)).enumerate().collect();
-        let known = cache.refined.len().min(starts.len());
-
-        let fresh: Vec<(usize, ScanPose, i64)> = if p.parallel {
-            starts[known..].par_iter().map_init(LocalScratch::default, |buf, &s| one(buf, s)).collect()
+        // Starts of the same window (the strict and tolerant searches often agree) are searched once.
+        let starts: Vec<(WindowKey, ScanPose)> = searches
+            .iter()
+            .flat_map(|f| f.poses.iter().chain(&f.rivals))
+            .map(|t_a_b| to_scan_pose(a, &scan.centroid, t_a_b))
+            .map(|start| (window_key(&start, a.resolution()), start))
+            .collect();
+        let mut todo: Vec<(WindowKey, ScanPose)> = Vec::new();
+        for s in &starts {
+            if !cache.windows.contains_key(&s.0) && todo.iter().all(|t| t.0 != s.0) {
+                todo.push(*s);
+            }
+        }
+        let fresh: Vec<(WindowKey, (ScanPose, i64))> = if p.parallel {
+            todo.par_iter().map_init(LocalScratch::default, one).collect()
         } else {
             let mut buf = LocalScratch::default();
-            starts[known..].iter().map(|&s| one(&mut buf, s)).collect()
+            todo.iter().map(|s| one(&mut buf, s)).collect()
         };
-        cache.refined.extend(fresh.iter().map(|&(_, q, s)| (q, s)));
+        cache.windows.extend(fresh);
         let mut refined: Vec<(usize, ScanPose, i64)> =
-            cache.refined[..starts.len()].iter().enumerate().map(|(i, &(q, s))| (i, q, s)).collect();
-        let mut buf = LocalScratch::default();
+            starts.iter().enumerate().map(|(i, s)| (i, cache.windows[&s.0].0, cache.windows[&s.0].1)).collect();
         refined.sort_by(|x, y| y.2.cmp(&x.2).then(x.0.cmp(&y.0)));
         let apart =
             |q: &ScanPose, k: &ScanPose| (q.tx - k.tx).hypot(q.ty - k.ty) + scan.radius * angle_gap(q.theta, k.theta);
@@ -634,18 +643,22 @@ impl CorrelativeMerger {
         let icp = RefineParams::default();
         let window0 = LocalWindow { cells: 0, angles: 0, angle_step: 0.0 };
         let transform = |q: &ScanPose| to_transform(a, &scan.centroid, q);
-        let mut polished: Vec<(usize, Pose2, i64)> = distinct
-            .iter()
-            .take(p.polished.max(1))
-            .map(|(i, q, _)| {
-                let (t, s) = *cache.polished.entry(*i).or_insert_with(|| {
-                    let t = refine(a, fine_points, &transform(q), &icp);
-                    let start = to_scan_pose(a, &scan.centroid, &t);
-                    (t, local_search(fine, a.resolution(), scan, start, &window0, &mut buf).1)
-                });
-                (*i, t, s)
-            })
-            .collect();
+        let top: Vec<(usize, ScanPose)> = distinct.iter().take(p.polished.max(1)).map(|&(i, q, _)| (i, q)).collect();
+        let polish = |buf: &mut LocalScratch, &(i, q): &(usize, ScanPose)| {
+            let t = refine(a, fine_points, &transform(&q), &icp);
+            let start = to_scan_pose(a, &scan.centroid, &t);
+            (i, (t, local_search(fine, a.resolution(), scan, start, &window0, buf).1))
+        };
+        let todo: Vec<(usize, ScanPose)> =
+            top.iter().filter(|(i, _)| !cache.polished.contains_key(i)).copied().collect();
+        let fresh: Vec<(usize, (Pose2, i64))> = if p.parallel {
+            todo.par_iter().map_init(LocalScratch::default, polish).collect()
+        } else {
+            todo.iter().map(|s| polish(&mut LocalScratch::default(), s)).collect()
+        };
+        cache.polished.extend(fresh);
+        let mut polished: Vec<(usize, Pose2, i64)> =
+            top.iter().map(|&(i, _)| (i, cache.polished[&i].0, cache.polished[&i].1)).collect();
         polished.sort_by(|x, y| y.2.cmp(&x.2).then(x.0.cmp(&y.0)));
         let from_first = searches.first().map_or(0, |f| f.poses.len() + f.rivals.len());
         let best_from_first = polished[0].0 < from_first;
