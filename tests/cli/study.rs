@@ -66,8 +66,9 @@ fn a_small_study_writes_consistent_results_summary_and_plot_and_shards_agree() {
     assert_eq!(header, COLUMNS);
     assert_eq!(rows.len(), 3 * 4 * 2);
     for (i, r) in rows.iter().enumerate() {
-        assert_eq!(r.len(), 13);
+        assert_eq!(r.len(), 14);
         assert!(r[11].is_empty() && r[12].is_empty(), "a cut pair has no SLAM drift: {r:?}");
+        assert!(r[13].is_empty(), "sift and rmap are not cascades: no stage: {r:?}");
         assert_eq!(r[0], (i / 2).to_string(), "sorted by trial");
         assert_eq!(r[4], if i % 2 == 0 { "sift" } else { "rmap" }, "then by algorithm");
         let (accepted, success, false_merge) = (r[5] == "true", r[6] == "true", r[7] == "true");
