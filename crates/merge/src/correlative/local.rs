@@ -117,9 +117,12 @@ pub fn local_search(
     best
 }
 
-/// What a window's answer depends on besides the field, the scan and its extent: the start's angle (its bits)
-/// and the cell its centroid falls in. Two starts with the same key have the same answer.
-pub fn window_key(start: &ScanPose, cell: f64) -> (u64, i32, i32) {
+/// A window by its start's angle (bits) and the cell its centroid falls in.
+pub type WindowKey = (u64, i32, i32);
+
+/// What a window's answer depends on besides the field, the scan and its extent: two starts with the same key
+/// have the same answer.
+pub fn window_key(start: &ScanPose, cell: f64) -> WindowKey {
     (start.theta.to_bits(), (start.tx / cell - 0.5).round() as i32, (start.ty / cell - 0.5).round() as i32)
 }
 

@@ -40,7 +40,7 @@ use crate::merger::{Alignment, Evidence, Hypothesis, Merger, NoAlignment};
 use crate::refine::{RefineParams, refine, wall_points};
 use crate::verify::{agreement, wall_hits};
 use field::{BlockStates, HIT, ScoreField};
-use local::{LocalScratch, LocalWindow, ScanPose, WindowField, local_search, window_key};
+use local::{LocalScratch, LocalWindow, ScanPose, WindowField, WindowKey, local_search, window_key};
 use mrslam_core::{OccupancyGrid, Pose2, pose};
 use nalgebra::{Point2, Rotation2};
 use pyramid::Pyramid;
@@ -365,9 +365,6 @@ impl FineField {
     }
 }
 
-/// A fine window by its start's angle (bits) and cell.
-type WindowKey = (u64, i32, i32);
-
 /// The fine stage's work on one pair kept between its calls, for one window extent: each window's answer, and
 /// each start's polish by its index among the starts.
 #[derive(Debug, Default)]
@@ -418,7 +415,7 @@ pub fn score_near(
     let mut pts = Vec::new();
     let (q, s) = local_search(&grid, cell, &scan, start, &window, &mut LocalScratch::default());
     scan.discretize(q.theta, cell, &mut pts);
-    let (cx, cy) = ((q.tx / cell - 0.5).round() as i32, (q.ty / cell - 0.5).round() as i32);
+    let (_, cx, cy) = window_key(&q, cell);
     let mut counts = [0usize; 3];
     for &(x, y) in &pts {
         let v = grid.get(x + cx, y + cy);
@@ -626,8 +623,14 @@ impl CorrelativeMerger {
             todo.iter().map(|s| one(&mut buf, s)).collect()
         };
         cache.windows.extend(fresh);
-        let mut refined: Vec<(usize, ScanPose, i64)> =
-            starts.iter().enumerate().map(|(i, s)| (i, cache.windows[&s.0].0, cache.windows[&s.0].1)).collect();
+        let mut refined: Vec<(usize, ScanPose, i64)> = starts
+            .iter()
+            .enumerate()
+            .map(|(i, (key, _))| {
+                let (q, score) = cache.windows[key];
+                (i, q, score)
+            })
+            .collect();
         refined.sort_by(|x, y| y.2.cmp(&x.2).then(x.0.cmp(&y.0)));
         let apart =
             |q: &ScanPose, k: &ScanPose| (q.tx - k.tx).hypot(q.ty - k.ty) + scan.radius * angle_gap(q.theta, k.theta);
@@ -654,11 +657,17 @@ impl CorrelativeMerger {
         let fresh: Vec<(usize, (Pose2, i64))> = if p.parallel {
             todo.par_iter().map_init(LocalScratch::default, polish).collect()
         } else {
-            todo.iter().map(|s| polish(&mut LocalScratch::default(), s)).collect()
+            let mut buf = LocalScratch::default();
+            todo.iter().map(|s| polish(&mut buf, s)).collect()
         };
         cache.polished.extend(fresh);
-        let mut polished: Vec<(usize, Pose2, i64)> =
-            top.iter().map(|&(i, _)| (i, cache.polished[&i].0, cache.polished[&i].1)).collect();
+        let mut polished: Vec<(usize, Pose2, i64)> = top
+            .iter()
+            .map(|&(i, _)| {
+                let (t, score) = cache.polished[&i];
+                (i, t, score)
+            })
+            .collect();
         polished.sort_by(|x, y| y.2.cmp(&x.2).then(x.0.cmp(&y.0)));
         let from_first = searches.first().map_or(0, |f| f.poses.len() + f.rivals.len());
         let best_from_first = polished[0].0 < from_first;
