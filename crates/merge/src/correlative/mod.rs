@@ -379,6 +379,20 @@ fn fine_window_cells(a: &OccupancyGrid, p: &CorrelativeParams) -> i32 {
     ((p.search_resolution / a.resolution()).round() as i32).max(1) + 1
 }
 
+/// `f` over `items` in order, on rayon or on this thread, each worker with its own scratch `S`.
+fn map_with_scratch<T: Sync, S: Default, R: Send>(
+    parallel: bool,
+    items: &[T],
+    f: impl Fn(&mut S, &T) -> R + Sync + Send,
+) -> Vec<R> {
+    if parallel {
+        items.par_iter().map_init(S::default, f).collect()
+    } else {
+        let mut scratch = S::default();
+        items.iter().map(|x| f(&mut scratch, x)).collect()
+    }
+}
+
 /// The global search's answers refined on the fine field, strongest first, and the significance of the first.
 struct Candidates {
     /// Polished poses `T_a_b` and their fine scores, strongest first.
@@ -513,12 +527,7 @@ impl CorrelativeMerger {
         let mut floor = min_floor;
         for (modulus, rest) in ROUNDS {
             let js: Vec<usize> = (0..n_rot).filter(|&j| j % modulus == rest && searched(j)).collect();
-            let found: Vec<Vec<Global>> = if p.parallel {
-                js.par_iter().map_init(Default::default, |s, &j| one(s, j, floor)).collect()
-            } else {
-                let mut scratch = Default::default();
-                js.iter().map(|&j| one(&mut scratch, j, floor)).collect()
-            };
+            let found = map_with_scratch(p.parallel, &js, |s, &j| one(s, j, floor));
             all.extend(found.into_iter().flatten());
             let top = all.iter().map(|g| g.candidate.score).max().unwrap_or(i64::MIN);
             floor = floor.max((p.keep_ratio * top as f64).ceil() as i64);
@@ -616,13 +625,7 @@ impl CorrelativeMerger {
                 todo.push(*s);
             }
         }
-        let fresh: Vec<(WindowKey, (ScanPose, i64))> = if p.parallel {
-            todo.par_iter().map_init(LocalScratch::default, one).collect()
-        } else {
-            let mut buf = LocalScratch::default();
-            todo.iter().map(|s| one(&mut buf, s)).collect()
-        };
-        cache.windows.extend(fresh);
+        cache.windows.extend(map_with_scratch(p.parallel, &todo, one));
         let mut refined: Vec<(usize, ScanPose, i64)> = starts
             .iter()
             .enumerate()
@@ -654,13 +657,7 @@ impl CorrelativeMerger {
         };
         let todo: Vec<(usize, ScanPose)> =
             top.iter().filter(|(i, _)| !cache.polished.contains_key(i)).copied().collect();
-        let fresh: Vec<(usize, (Pose2, i64))> = if p.parallel {
-            todo.par_iter().map_init(LocalScratch::default, polish).collect()
-        } else {
-            let mut buf = LocalScratch::default();
-            todo.iter().map(|s| polish(&mut buf, s)).collect()
-        };
-        cache.polished.extend(fresh);
+        cache.polished.extend(map_with_scratch(p.parallel, &todo, polish));
         let mut polished: Vec<(usize, Pose2, i64)> = top
             .iter()
             .map(|&(i, _)| {
