@@ -20,6 +20,7 @@ fn set(p: &mut CorrelativeParams, kv: &str) {
         "fsigma" => p.fine_sigma_cells = f,
         "pen" => p.free_penalty = f,
         "fpen" => p.fine_free_penalty = f,
+        "dense" => p.dense_free_share = f,
         "fbpen" => p.fallback_free_penalty = f,
         "fbarea" => p.fallback_min_overlap_m2 = f,
         "depth" => p.depth = f as usize,

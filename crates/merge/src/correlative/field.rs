@@ -2,7 +2,8 @@
 //!
 //! Walls of a are blurred with a Gaussian of their distance (Olson 2009's likelihood field), known free
 //! cells far from any wall score a penalty (a wall of b laid across a's free space is evidence against the
-//! pose), unknown cells and everything off the grid score 0.
+//! pose), unknown cells and everything off the grid score 0. Free space can be made to count only where it is
+//! dense: a single ray's line of free cells beyond a wall left unknown ([`BlockStates::keep_dense_free`]).
 
 use mrslam_core::{CellState, OccupancyGrid};
 
@@ -26,14 +27,21 @@ pub struct BlockStates {
 impl BlockStates {
     /// Pools `g` into blocks of `factor × factor` cells (`factor` at least 1).
     pub fn of(g: &OccupancyGrid, factor: usize) -> Self {
+        let cells: Vec<CellState> = g.cells().iter().map(|&l| CellState::from_log_odds(l)).collect();
+        BlockStates { width: g.width(), height: g.height(), factor: 1, states: cells }.pooled(factor)
+    }
+
+    /// These blocks pooled again into blocks of `factor × factor` of them (`factor` at least 1).
+    pub fn pooled(&self, factor: usize) -> Self {
         let f = factor.max(1);
-        let (w, h) = (g.width().div_ceil(f), g.height().div_ceil(f));
+        if f == 1 {
+            return self.clone();
+        }
+        let (w, h) = (self.width.div_ceil(f), self.height.div_ceil(f));
         let mut states = vec![CellState::Unknown; w * h];
-        let gw = g.width();
-        for (iy, row) in g.cells().chunks_exact(gw.max(1)).enumerate() {
+        for (iy, row) in self.states.chunks_exact(self.width.max(1)).enumerate() {
             let out = &mut states[(iy / f) * w..(iy / f + 1) * w];
-            for (ix, &l) in row.iter().enumerate() {
-                let s = CellState::from_log_odds(l);
+            for (ix, &s) in row.iter().enumerate() {
                 let o = &mut out[ix / f];
                 *o = match (*o, s) {
                     (CellState::Occupied, _) | (_, CellState::Occupied) => CellState::Occupied,
@@ -42,7 +50,44 @@ impl BlockStates {
                 };
             }
         }
-        BlockStates { width: w, height: h, factor: f, states }
+        BlockStates { width: w, height: h, factor: self.factor * f, states }
+    }
+}
+
+impl BlockStates {
+    /// Leaves free only the free blocks with at least `share` of the `side × side` blocks centred on them free
+    /// (`side` odd; the grid's edge counts as not free): one stray ray through a room's wall marks a line of
+    /// free cells that a wall of the other map should not be penalised for.
+    pub fn keep_dense_free(&mut self, side: usize, share: f64) {
+        let (w, h) = (self.width, self.height);
+        if share <= 0.0 || w == 0 || h == 0 {
+            return;
+        }
+        let r = side / 2;
+        let needed = ((share.min(1.0) * ((2 * r + 1) * (2 * r + 1)) as f64).ceil() as u32).max(1);
+        // Summed-area table of free blocks, (w + 1) × (h + 1).
+        let mut sum = vec![0u32; (w + 1) * (h + 1)];
+        for y in 0..h {
+            let mut row = 0u32;
+            for x in 0..w {
+                row += u32::from(self.states[y * w + x] == CellState::Free);
+                sum[(y + 1) * (w + 1) + x + 1] = sum[y * (w + 1) + x + 1] + row;
+            }
+        }
+        for y in 0..h {
+            let (y0, y1) = (y.saturating_sub(r), (y + r + 1).min(h));
+            for x in 0..w {
+                if self.states[y * w + x] != CellState::Free {
+                    continue;
+                }
+                let (x0, x1) = (x.saturating_sub(r), (x + r + 1).min(w));
+                let free =
+                    sum[y1 * (w + 1) + x1] + sum[y0 * (w + 1) + x0] - sum[y0 * (w + 1) + x1] - sum[y1 * (w + 1) + x0];
+                if free < needed {
+                    self.states[y * w + x] = CellState::Unknown;
+                }
+            }
+        }
     }
 }
 
@@ -154,6 +199,30 @@ mod tests {
         assert_eq!(f.get(10, 5), 0);
         assert_eq!(f.get(-1, 5), 0);
         assert_eq!(f.get(3, 10), 0);
+    }
+
+    #[test]
+    fn a_ray_of_free_cells_is_not_dense_free_space_a_room_is() {
+        let mut g = OccupancyGrid::new(30, 20, 0.05, pose(0.0, 0.0, 0.0)).unwrap();
+        for iy in 0..10 {
+            for ix in 0..10 {
+                g.set(ix, iy, -2.0); // a room
+            }
+        }
+        for ix in 10..30 {
+            g.set(ix, 15, -2.0); // a ray through nothing else known
+        }
+        let mut b = BlockStates::of(&g, 1);
+        b.keep_dense_free(5, 0.5);
+        let at = |x: usize, y: usize| b.states[y * b.width + x];
+        assert_eq!(at(5, 5), CellState::Free);
+        assert_eq!(at(0, 0), CellState::Unknown, "a corner sees 9 of 25 free cells");
+        assert_eq!(at(2, 2), CellState::Free);
+        assert_eq!(at(20, 15), CellState::Unknown);
+        assert_eq!(at(25, 5), CellState::Unknown);
+        let mut unchanged = BlockStates::of(&g, 1);
+        unchanged.keep_dense_free(5, 0.0);
+        assert_eq!(unchanged.states, BlockStates::of(&g, 1).states);
     }
 
     #[test]
