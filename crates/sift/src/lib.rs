@@ -20,7 +20,6 @@ mod dispatch;
 mod error;
 mod extrema;
 mod fastmath;
-mod huge_pages;
 mod image;
 mod keypoint;
 mod mask;

@@ -54,16 +54,9 @@ pub struct Octave {
 /// it saves (textured images): the octave is computed in full.
 const MAX_EDGE_DENSITY: f64 = 0.3;
 
-/// Grows `buf` to at least `n` values (never shrinks it), a new allocation backed by huge pages where the
-/// system offers them ([`crate::huge_pages`]).
+/// Grows `buf` to at least `n` values (never shrinks it).
 fn ensure_len(buf: &mut Vec<f32>, n: usize) {
     if buf.len() < n {
-        if buf.capacity() < n {
-            let mut grown = Vec::with_capacity(n);
-            crate::huge_pages::advise(&grown);
-            grown.extend_from_slice(buf);
-            *buf = grown;
-        }
         buf.resize(n, 0.0);
     }
 }
