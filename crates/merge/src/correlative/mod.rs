@@ -995,6 +995,42 @@ mod tests {
     }
 
     #[test]
+    fn single_rays_into_unknown_space_do_not_count_against_the_true_pose() {
+        // a: the building's left 100 columns (the rest unknown); b: the whole building; the truth: identity.
+        let b = building(true);
+        let mut a = b.clone();
+        for iy in 0..120 {
+            for ix in 100..160 {
+                a.set(ix, iy, 0.0);
+            }
+        }
+        // The same a crossed by a fan of single rays from (50, 60) out over its unknown part, as a real lidar
+        // sees through glass: lines of free cells where b's walls are.
+        let mut rays = a.clone();
+        for k in 0..24 {
+            let th = -0.6 + 1.2 * f64::from(k) / 23.0;
+            for s in 50..200 {
+                let (ix, iy) = ((50.0 + f64::from(s) * th.cos()) as usize, (60.0 + f64::from(s) * th.sin()) as usize);
+                if (100..160).contains(&ix) && (2..118).contains(&iy) {
+                    rays.set(ix, iy, -2.0);
+                }
+            }
+        }
+        let score = |share: f64, a: &OccupancyGrid| {
+            let merger = CorrelativeMerger::new(CorrelativeParams { dense_free_share: share, ..Default::default() });
+            let (s, counts, _) = score_near(&merger, a, &b, &Pose2::identity());
+            (s, counts[1])
+        };
+        let (dense, dense_rays) = (score(0.5, &a), score(0.5, &rays));
+        let (every, every_rays) = (score(0.0, &a), score(0.0, &rays));
+        // Without the rays the two agree; counting every free cell, b's walls under the rays (28 of its points)
+        // sink the true pose below zero; counting dense free space only, the rays change nothing.
+        assert_eq!(dense, every);
+        assert!(every_rays.1 >= every.1 + 20 && every_rays.0 < 0, "{every:?} -> {every_rays:?}");
+        assert_eq!(dense_rays, dense);
+    }
+
+    #[test]
     fn the_margin_is_the_winners_lead_over_its_rival() {
         let s = |best, rival: Option<i64>| Significance {
             best: Pose2::identity(),
