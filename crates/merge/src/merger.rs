@@ -91,6 +91,10 @@ pub trait Merger: Send + Sync {
     fn needs_marked_walls(&self) -> bool {
         false
     }
+    /// The gate its answers go through, given the pipeline's: that gate unless the algorithm says otherwise.
+    fn gate(&self, verify: &VerifyParams) -> VerifyParams {
+        *verify
+    }
 }
 
 /// Parameters of the pipeline around an algorithm.
@@ -311,6 +315,7 @@ pub(crate) fn merge_bounded(
     {
         return refused(merger, reason, 0, BTreeMap::new(), start);
     }
+    let p = &MergeParams { verify: merger.gate(&p.verify), ..*p };
     // Maps that do not mark their walls get them from their free/unknown boundary; the fusion takes the maps as given.
     let (given_a, given_b) = (a, b);
     let (walled_a, walled_b) = match boundaries {
