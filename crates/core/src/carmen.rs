@@ -154,6 +154,7 @@ pub struct Repairs {
     pub shared_scan_stamps: usize,
     /// ODOM lines dropped because another ODOM line has the same stamp.
     pub duplicate_odometry: usize,
+
     /// ODOM increments that reported reversing (`tv` < 0) but moved forwards, turned round
     /// ([`ReadOptions::repair_reversing`]).
     pub reversed_increments: usize,
@@ -343,7 +344,8 @@ impl CarmenLog {
                 "ODOM" => {
                     let v = numbers(&rest, 7, "x y theta tv rv accel ipc_timestamp").map_err(err)?;
                     odometry.push((Odometry { stamp: v[6], pose: pose(v[0], v[1], v[2]) }, v[3]));
-                    Some(v[6])
+                    // Scans that take their own line's odometry do not depend on the ODOM lines' stamps.
+                    (options.odometry != OdometrySource::Line).then_some(v[6])
                 }
                 k if k.starts_with('#') => {
                     *log.skipped.entry("comment".into()).or_default() += 1;
@@ -361,8 +363,14 @@ impl CarmenLog {
                         if back > options.max_step_back {
                             return Err(err(format!(
                                 "ipc_timestamp {stamp} is {back:.3} s before the stamp {t} on line {at}: more than \
-                                 the {} s a log may step back (two logs joined, or a clock reset?)",
-                                options.max_step_back
+                                 the {} s a log may step back (two logs joined, or a clock reset?){}",
+                                options.max_step_back,
+                                if kind == "ODOM" {
+                                    "; `--odometry line` takes each scan's odometry from its own line and leaves the \
+                                     ODOM lines' stamps alone"
+                                } else {
+                                    ""
+                                }
                             )));
                         }
                         let r = &mut log.repairs;
@@ -700,6 +708,27 @@ ODOM 0.0 0.0 0.0 0.0 0.0 0.0 1.0 host 1.0
         let opts = ReadOptions { max_step_back: 20.0, ..ReadOptions::default() };
         let log = CarmenLog::parse_with(text.as_bytes(), Path::new("b.clf"), &opts).unwrap();
         assert_eq!((log.repairs.out_of_order, log.repairs.max_step_back_line), (1, 3));
+    }
+
+    #[test]
+    fn odometry_lines_out_of_time_are_refused_unless_scans_take_their_own_odometry() {
+        // As GMapping writes its logs: ODOM lines of another clock between the stamped ones.
+        let text = "\
+ODOM 0.1 0 0 0 0 0 10.0 h 10.0
+FLASER 3 1 2 3 0.1 0 0 0.1 0 0 10.0 h 10.0
+ODOM 9 9 0 0 0 0 0.7 h 0.7
+ODOM 0.2 0 0 0 0 0 11.0 h 11.0
+FLASER 3 1 2 3 0.2 0 0 0.2 0 0 11.0 h 11.0
+";
+        let e = CarmenLog::parse(text.as_bytes(), Path::new("g.log")).unwrap_err().to_string();
+        assert!(
+            e.starts_with("g.log:3: ODOM: ipc_timestamp 0.7 is 9.300 s before") && e.contains("--odometry line"),
+            "{e}"
+        );
+        let opts = ReadOptions { odometry: OdometrySource::Line, ..ReadOptions::default() };
+        let log = CarmenLog::parse_with(text.as_bytes(), Path::new("g.log"), &opts).unwrap();
+        assert_eq!((log.scans.len(), log.repairs.out_of_order, log.repairs.line_odometry), (2, 0, 2));
+        assert_close(Xyt::from_pose(&log.scans[1].odometry.pose), (0.2, 0.0, 0.0));
     }
 
     #[test]
