@@ -133,3 +133,19 @@ fn log_info_counts_and_bad_line_names_its_number() {
     let bad = write(dir.path(), "bad.clf", b"ODOM 0 0 0 0 0 0 1.0 h 1.0\nFLASER 3 1 2 3 0 0\n");
     assert_fails_with(&["log", "info", bad.to_str().unwrap()], &["bad.clf:2", "FLASER", "expected at least"]);
 }
+
+#[test]
+fn log_info_reads_odom_lines_of_another_clock_with_odometry_line() {
+    // As GMapping writes a log: between the stamped ODOM lines, ODOM lines of another clock.
+    let dir = tempfile::tempdir().unwrap();
+    let log = write(
+        dir.path(),
+        "gmapping.log",
+        b"ODOM 0.1 0 0 0 0 0 10.0 h 10.0\nFLASER 3 1 2 3 0.1 0 0 0.1 0 0 10.0 h 10.0\nODOM 9 9 0 0 0 0 0.7 h 0.7\n\
+ODOM 0.2 0 0 0 0 0 11.0 h 11.0\nFLASER 3 1 2 3 0.2 0 0 0.2 0 0 11.0 h 11.0\n",
+    );
+    assert_fails_with(&["log", "info", log.to_str().unwrap()], &["gmapping.log:3: ODOM", "--odometry line"]);
+    let o = mrslam(&["log", "info", log.to_str().unwrap(), "--odometry", "line"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stdout(&o).contains("scans use the scan lines' own odometry fields (2 scans)"), "{}", stdout(&o));
+}
