@@ -78,9 +78,9 @@ pub struct CorrelativeParams {
     /// A real robot's map is crossed by single rays that pass through glass, doors and gaps far beyond the
     /// walls: thin lines of free cells. Counted as free space they put the other map's walls "in a room": on
     /// ACES in 4 parts, 99 of b's 513 wall points fell on a's free space at the true pose of a pair with 13
-    /// relations, and the pair was refused; at 0.5, 12 did and it merged 0.09 m off. With the two logs in 4, 5, 6
-    /// and 9 parts (and `min_acceptance` 0.97): ACES 19 of 39 pairs merged correctly instead of 16, 3 false instead of 5;
-    /// FR079 45 of 46 as before; generated plans and willow cuts as before.
+    /// relations, and the pair was refused; at 0.5, 12 did and it merged 0.11 m off. With the two logs in 4, 5, 6
+    /// and 9 parts (and `min_acceptance` 0.97): ACES 19 of 39 pairs merged correctly instead of 16, 3 false
+    /// instead of 5; FR079 45 of 46 as before; generated plans and willow cuts as before.
     pub dense_free_share: f64,
     /// [`CorrelativeParams::free_penalty`] of the fine field, which ranks the answers and decides the
     /// significance test (at 1 with the global search at 2, a wrong pose won both ACES pairs that need the fallback).
