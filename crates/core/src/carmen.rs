@@ -154,7 +154,6 @@ pub struct Repairs {
     pub shared_scan_stamps: usize,
     /// ODOM lines dropped because another ODOM line has the same stamp.
     pub duplicate_odometry: usize,
-
     /// ODOM increments that reported reversing (`tv` < 0) but moved forwards, turned round
     /// ([`ReadOptions::repair_reversing`]).
     pub reversed_increments: usize,

@@ -27,8 +27,14 @@ pub struct BlockStates {
 impl BlockStates {
     /// Pools `g` into blocks of `factor × factor` cells (`factor` at least 1).
     pub fn of(g: &OccupancyGrid, factor: usize) -> Self {
-        let cells: Vec<CellState> = g.cells().iter().map(|&l| CellState::from_log_odds(l)).collect();
-        BlockStates { width: g.width(), height: g.height(), factor: 1, states: cells }.pooled(factor)
+        let cells = Self::cells(g);
+        if factor <= 1 { cells } else { cells.pooled(factor) }
+    }
+
+    /// `g`'s own cells as blocks of one cell.
+    pub fn cells(g: &OccupancyGrid) -> Self {
+        let states = g.cells().iter().map(|&l| CellState::from_log_odds(l)).collect();
+        BlockStates { width: g.width(), height: g.height(), factor: 1, states }
     }
 
     /// These blocks pooled again into blocks of `factor × factor` of them (`factor` at least 1).
@@ -52,9 +58,7 @@ impl BlockStates {
         }
         BlockStates { width: w, height: h, factor: self.factor * f, states }
     }
-}
 
-impl BlockStates {
     /// Leaves free only the free blocks with at least `share` of the `side × side` blocks centred on them free
     /// (`side` odd; the grid's edge counts as not free): one stray ray through a room's wall marks a line of
     /// free cells that a wall of the other map should not be penalised for.

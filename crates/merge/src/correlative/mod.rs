@@ -357,22 +357,24 @@ struct Pooled {
 }
 
 impl Pooled {
-    fn build(a: &OccupancyGrid, b: &OccupancyGrid, resolution: f64, max_points: usize, dense_free_share: f64) -> Self {
+    /// `cells_a`: a's cells as [`dense_free_cells`] gives them.
+    fn build(a: &OccupancyGrid, cells_a: &BlockStates, b: &OccupancyGrid, resolution: f64, max_points: usize) -> Self {
         let fa = ((resolution / a.resolution()).round() as usize).max(1);
         let fb = ((resolution / b.resolution()).round() as usize).max(1);
         Pooled {
             cell: fa as f64 * a.resolution(),
-            blocks: dense_free_cells(a, fa, dense_free_share).pooled(fa),
+            blocks: cells_a.pooled(fa),
             scan: WallScan::of_blocks(b, fb, max_points),
         }
     }
 }
 
-/// a's cell states with its free cells kept only where at least `share` of the search cell's extent (`factor`
-/// cells, made odd) around them is free ([`CorrelativeParams::dense_free_share`]).
-fn dense_free_cells(a: &OccupancyGrid, factor: usize, share: f64) -> BlockStates {
-    let mut cells = BlockStates::of(a, 1);
-    cells.keep_dense_free(factor | 1, share);
+/// a's cell states with its free cells kept only where at least [`CorrelativeParams::dense_free_share`] of the
+/// search cell's extent (made odd) around them is free: what both the global search and the fine field score.
+fn dense_free_cells(a: &OccupancyGrid, p: &CorrelativeParams) -> BlockStates {
+    let fa = ((p.search_resolution / a.resolution()).round() as usize).max(1);
+    let mut cells = BlockStates::cells(a);
+    cells.keep_dense_free(fa | 1, p.dense_free_share);
     cells
 }
 
@@ -388,12 +390,12 @@ struct FineField {
 }
 
 impl FineField {
-    fn build(a: &OccupancyGrid, b: &OccupancyGrid, p: &CorrelativeParams) -> Self {
+    /// `cells_a`: a's cells as [`dense_free_cells`] gives them.
+    fn build(a: &OccupancyGrid, cells_a: &BlockStates, b: &OccupancyGrid, p: &CorrelativeParams) -> Self {
         let points = wall_points(b);
         let scan = WallScan::of_points(&points, p.max_fine_points);
         let penalty = (p.fine_free_penalty.max(0.0) * f64::from(HIT)).round() as i16;
-        let fa = ((p.search_resolution / a.resolution()).round() as usize).max(1);
-        let field = ScoreField::build(&dense_free_cells(a, fa, p.dense_free_share), p.fine_sigma_cells, penalty);
+        let field = ScoreField::build(cells_a, p.fine_sigma_cells, penalty);
         FineField { points, scan, field: WindowField::new(&field, fine_window_cells(a, p) as usize) }
     }
 }
@@ -454,7 +456,7 @@ pub fn score_near(
     let cell = fa as f64 * a.resolution();
     let scan = WallScan::of_blocks(b, fb, p.max_points);
     let penalty = (p.free_penalty.max(0.0) * f64::from(HIT)).round() as i16;
-    let field = ScoreField::build(&dense_free_cells(a, fa, p.dense_free_share).pooled(fa), p.sigma_cells, penalty);
+    let field = ScoreField::build(&dense_free_cells(a, p).pooled(fa), p.sigma_cells, penalty);
     let grid = WindowField::new(&field, 2);
     let step = (p.angle_step_scale * cell / scan.radius.max(cell)).min(PI / 2.0);
     let window = LocalWindow { cells: 2, angles: 2, angle_step: step };
@@ -728,15 +730,16 @@ impl CorrelativeMerger {
     ) -> Result<Candidates, Box<NoAlignment>> {
         let p = &self.params;
         let t = Instant::now();
-        let pooled = Pooled::build(a, b, p.search_resolution, p.max_points, p.dense_free_share);
+        let cells_a = dense_free_cells(a, p);
+        let pooled = Pooled::build(a, &cells_a, b, p.search_resolution, p.max_points);
         timings.insert("pool".into(), ms(t));
         let t = Instant::now();
         let peaks =
             if p.rotation_prior { orientation::rotation_peaks(a, b, p.rotation_peak_ratio) } else { Vec::new() };
         timings.insert("orientation".into(), ms(t));
-        let strict = self.search(a, b, &pooled, &peaks, timings)?;
+        let strict = self.search(a, &cells_a, b, &pooled, &peaks, timings)?;
         let t = Instant::now();
-        let fine = FineField::build(a, b, p);
+        let fine = FineField::build(a, &cells_a, b, p);
         timings.insert("fine_field".into(), ms(t));
         let mut cache = FineCache::default();
         let first = self.candidates(a, &fine, &[&strict], &mut cache, timings);
@@ -757,7 +760,7 @@ impl CorrelativeMerger {
             ..*p
         });
         let mut more = BTreeMap::new();
-        let Ok(second) = tolerant.search(a, b, &pooled, &peaks, &mut more) else {
+        let Ok(second) = tolerant.search(a, &cells_a, b, &pooled, &peaks, &mut more) else {
             return Ok(first);
         };
         for (k, v) in more {
@@ -810,6 +813,7 @@ impl CorrelativeMerger {
     fn search(
         &self,
         a: &OccupancyGrid,
+        cells_a: &BlockStates,
         b: &OccupancyGrid,
         pooled: &Pooled,
         peaks: &[f64],
@@ -820,7 +824,7 @@ impl CorrelativeMerger {
             return self.global(a, pooled, p.hypotheses, peaks, timings);
         }
         let t = Instant::now();
-        let screen = Pooled::build(a, b, p.screen_resolution, p.max_points, p.dense_free_share);
+        let screen = Pooled::build(a, cells_a, b, p.screen_resolution, p.max_points);
         timings.insert("pool_screen".into(), ms(t));
         let coarse = self.global(a, &screen, p.screen_candidates, peaks, timings)?;
         // Each screened answer searched again around itself at the search resolution.
