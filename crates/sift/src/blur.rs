@@ -163,22 +163,25 @@ pub fn blur(
     }
 }
 
-/// Blurs rows `y0 .. y1` of `dst` from `src` (both `w x h`); `src` rows up to `min(h, y1 + radius)` (and
-/// the first `radius` rows) must be final. Used to run the layers of an octave as a cache-friendly wavefront.
+/// Blurs rows `y0 .. y1` of the image into `dst`, which holds the image's rows from `dst_y0` on, from `src` (a
+/// view that may hold a window of rows: those the kernel reads around `y0 .. y1`, reflected at the image's
+/// edges, must be in it and final). Used to run the layers of an octave as a cache-friendly wavefront.
+#[allow(clippy::too_many_arguments)]
 pub fn blur_band(
     src: Plane<'_>,
     dst: &mut [f32],
+    dst_y0: usize,
     y0: usize,
     y1: usize,
     kernel: &Kernel,
     scratch: &mut BlurScratch,
     sparse: Option<Sparse<'_>>,
 ) {
-    let (w, h) = (src.w, src.h);
+    let w = src.w;
     if w == 0 || y0 >= y1 {
         return;
     }
-    blur_rows(Plane::new(&src.data[..w * h], w, h), &mut dst[y0 * w..y1 * w], y0, kernel, scratch, sparse);
+    blur_rows(src, &mut dst[(y0 - dst_y0) * w..(y1 - dst_y0) * w], y0, kernel, scratch, sparse);
 }
 
 crate::cpu_dispatch! {
@@ -347,7 +350,8 @@ fn blur_rows_impl(
     s: &mut BlurScratch,
     sparse: Option<Sparse<'_>>,
 ) {
-    let Plane { data: src, w, h } = src;
+    let held = src.rows();
+    let Plane { data: src, w, h, y0: sy0 } = src;
     let k = &kernel.half[..];
     let r = k.len() - 1;
     let stride = w + 2 * r;
@@ -356,8 +360,8 @@ fn blur_rows_impl(
     let taps = 2 * r + QUAD;
     let chunks = w.div_ceil(CHUNK);
     let cwpr = chunks.div_ceil(64);
-    // The unchecked reads of `vquad` rely on these.
-    assert!(src.len() >= w * h && (y0 + n_rows) <= h, "blur: image smaller than its size");
+    // The unchecked reads of `vquad` rely on these (and on the window check of each source row below).
+    assert!(src.len() >= held.len() * w && (y0 + n_rows) <= h, "blur: image smaller than its size");
     if s.vbuf.len() < GROUP * stride {
         s.vbuf.resize(GROUP * stride, 0.0);
     }
@@ -393,8 +397,13 @@ fn blur_rows_impl(
         let quads = gn.div_ceil(QUAD);
         for q in 0..quads {
             let yq = (y0 + gy + q * QUAD) as isize;
+            // A short last quad also computes rows past the group (dropped): their extra taps read the last
+            // needed source row, so a window of source rows need not hold more.
+            let needed = 2 * r + (gn - q * QUAD).min(QUAD);
             for (m, t) in s.rows[q * taps..(q + 1) * taps].iter_mut().enumerate() {
-                *t = reflect101(yq - r as isize + m as isize, h) * w;
+                let row = reflect101(yq - r as isize + m.min(needed - 1) as isize, h);
+                assert!(held.contains(&row), "blur: source row {row} outside the rows held {held:?}");
+                *t = (row - sy0) * w;
             }
         }
         // Vertical pass, strip by strip (the source rows of a strip stay in L1), four rows at a time.
@@ -454,7 +463,7 @@ fn blur_rows_impl(
             let buf = &mut s.vbuf[j * stride..(j + 1) * stride];
             if let Some(m) = sparse {
                 // Columns the vertical pass skipped see one constant: the source pixel's.
-                let row = &src[y * w..y * w + w];
+                let row = &src[(y - sy0) * w..(y - sy0) * w + w];
                 for (a, b, on) in ChunkRuns::new(m.vert.row(y), m.vert.chunks) {
                     if !on {
                         let (a, b) = cols(a, b, w);

@@ -16,7 +16,8 @@ pub const DESCR_MAG_THR: f32 = 0.2;
 /// Factor turning the normalised descriptor into bytes.
 pub const INT_DESCR_FCTR: f32 = 512.0;
 
-const D: usize = DESCR_WIDTH;
+/// Cells per side of the descriptor grid.
+pub const D: usize = DESCR_WIDTH;
 const N: usize = DESCR_HIST_BINS;
 const HIST_LEN: usize = (D + 2) * (D + 2) * (N + 2);
 /// Samples whose histogram shares are computed together.
@@ -118,6 +119,14 @@ pub struct Frame {
     pub scl: f32,
 }
 
+/// Radius of the window a descriptor at scale `scl` reads in a `w` x `h` image (OpenCV: the rotated
+/// histogram's bounding square, at most the image's diagonal).
+pub fn radius(scl: f32, w: usize, h: usize) -> usize {
+    let r = (DESCR_SCL_FCTR * scl * std::f32::consts::SQRT_2 * (D as f32 + 1.0) * 0.5).round_ties_even() as isize;
+    let diag = ((w as f64) * (w as f64) + (h as f64) * (h as f64)).sqrt() as isize;
+    r.clamp(0, diag) as usize
+}
+
 crate::cpu_dispatch! {
     /// Computes the descriptor of Gaussian image `img` (`w` x `h`) in frame `at`.
     pub fn descriptor(img: Plane<'_>, at: Frame, out: &mut [u8], s: &mut DescScratch);
@@ -130,7 +139,7 @@ crate::cpu_dispatch! {
 /// are gathered 16 columns at a time (the same values in the same order as the scalar loop).
 #[inline(always)]
 fn descriptor_impl<const AVX512: bool>(img: Plane<'_>, at: Frame, out: &mut [u8], s: &mut DescScratch) {
-    let Plane { data: img, w, h } = img;
+    let Plane { data: img, w, h, y0 } = img;
     let Frame { px, py, ori, scl } = at;
     let (ptx, pty) = (px.round_ties_even() as isize, py.round_ties_even() as isize);
     let rad = ori * (std::f32::consts::PI / 180.0);
@@ -138,9 +147,7 @@ fn descriptor_impl<const AVX512: bool>(img: Plane<'_>, at: Frame, out: &mut [u8]
     let bins_per_rad = N as f32 / 360.0;
     let exp_scale = -1.0 / (D as f32 * D as f32 * 0.5);
     let hist_width = DESCR_SCL_FCTR * scl;
-    let mut radius = (hist_width * std::f32::consts::SQRT_2 * (D as f32 + 1.0) * 0.5).round_ties_even() as isize;
-    let diag = ((w as f64) * (w as f64) + (h as f64) * (h as f64)).sqrt() as isize;
-    radius = radius.clamp(0, diag);
+    let radius = radius(scl, w, h) as isize;
     cos_t /= hist_width;
     sin_t /= hist_width;
     // Gaussian weight exp(-(c_rot^2 + r_rot^2) / (2 (d/2)^2)) is radial, so separable in (i, j).
@@ -167,7 +174,7 @@ fn descriptor_impl<const AVX512: bool>(img: Plane<'_>, at: Frame, out: &mut [u8]
         if r <= 0 || r >= h as isize - 1 {
             continue;
         }
-        let row = r as usize * w;
+        let row = (r as usize - y0) * w;
         let fi = i as f32;
         let wi = ex[i.unsigned_abs()];
         let (up, mid, down) = (&img[row - w..row], &img[row..row + w], &img[row + w..row + 2 * w]);

@@ -36,20 +36,28 @@ pub struct Refined {
 /// DoG values of one octave, formed on demand from its Gaussian layers: `D_l = G_{l+1} - G_l`.
 #[derive(Debug, Clone, Copy)]
 pub struct DogView<'a> {
-    /// The octave's Gaussian layers (each at least `w * h` long).
+    /// The octave's Gaussian layers, each holding the rows `rows` from its start.
     pub gauss: &'a [Vec<f32>],
     /// Row length.
     pub w: usize,
+    /// The first row the layers hold (0 for a whole octave).
+    pub y0: usize,
+    /// The row after the last the layers hold (final in every layer).
+    pub y1: usize,
 }
 
 impl DogView<'_> {
     /// DoG layer `l` at row `r`, column `c`.
     #[inline(always)]
     pub fn at(&self, l: usize, r: isize, c: isize) -> f32 {
-        let i = (r * self.w as isize + c) as usize;
+        let i = ((r - self.y0 as isize) * self.w as isize + c) as usize;
         self.gauss[l + 1][i] - self.gauss[l][i]
     }
 }
+
+/// A refinement stepped to rows the view does not hold (a windowed octave): redo it on the whole octave.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct OutOfWindow;
 
 /// Columns tested together (the scan mask's chunks).
 const CHUNK: usize = crate::mask::CHUNK;
@@ -82,6 +90,7 @@ crate::cpu_dispatch! {
     #[allow(clippy::too_many_arguments)]
     pub fn find_candidates(
         gauss: &[Vec<f32>],
+        y0: usize,
         w: usize,
         h: usize,
         n_layers: usize,
@@ -93,16 +102,17 @@ crate::cpu_dispatch! {
         out: &mut Vec<Candidate>,
     );
     "avx512f" => find_candidates_avx512 =>
-        find_candidates_impl(gauss, w, h, n_layers, threshold, border, rows, mask, ring, out);
+        find_candidates_impl(gauss, y0, w, h, n_layers, threshold, border, rows, mask, ring, out);
     "avx2" => find_candidates_avx2 =>
-        find_candidates_impl(gauss, w, h, n_layers, threshold, border, rows, mask, ring, out);
-    _ => find_candidates_impl(gauss, w, h, n_layers, threshold, border, rows, mask, ring, out)
+        find_candidates_impl(gauss, y0, w, h, n_layers, threshold, border, rows, mask, ring, out);
+    _ => find_candidates_impl(gauss, y0, w, h, n_layers, threshold, border, rows, mask, ring, out)
 }
 
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
 fn find_candidates_impl(
     gauss: &[Vec<f32>],
+    y0: usize,
     w: usize,
     h: usize,
     n_layers: usize,
@@ -151,6 +161,7 @@ fn find_candidates_impl(
     #[allow(clippy::too_many_arguments)]
     fn fill(
         gauss: &[Vec<f32>],
+        y0: usize,
         w: usize,
         n_dog: usize,
         ring: (&mut [f32], &mut [f32], &mut [f32]),
@@ -164,7 +175,7 @@ fn find_candidates_impl(
     ) {
         let (dog, hmax, hmin) = ring;
         if !masked {
-            fill_row(gauss, w, n_dog, (dog, hmax, hmin), y, 1, w - 1);
+            fill_row(gauss, y0, w, n_dog, (dog, hmax, hmin), y, 1, w - 1);
             return;
         }
         union.fill(0);
@@ -176,7 +187,7 @@ fn find_candidates_impl(
         for (a, b, on) in ChunkRuns::new(union, chunks) {
             if on {
                 let (c0, c1) = (border + a * CHUNK, (border + b * CHUNK).min(end));
-                fill_row(gauss, w, n_dog, (&mut *dog, &mut *hmax, &mut *hmin), y, c0, c1);
+                fill_row(gauss, y0, w, n_dog, (&mut *dog, &mut *hmax, &mut *hmin), y, c0, c1);
             }
         }
     }
@@ -185,12 +196,12 @@ fn find_candidates_impl(
     if r_from == border {
         for y in [border - 1, border] {
             let ring = (&mut *dog, &mut *hmax, &mut *hmin);
-            fill(gauss, w, n_dog, ring, y, masked, near(y), &mut union, chunks, border, end);
+            fill(gauss, y0, w, n_dog, ring, y, masked, near(y), &mut union, chunks, border, end);
         }
     }
     for r in r_from..r_to {
         let ring = (&mut *dog, &mut *hmax, &mut *hmin);
-        fill(gauss, w, n_dog, ring, r + 1, masked, near(r + 1), &mut union, chunks, border, end);
+        fill(gauss, y0, w, n_dog, ring, r + 1, masked, near(r + 1), &mut union, chunks, border, end);
         let (dog, hmax, hmin): (&[f32], &[f32], &[f32]) = (dog, hmax, hmin);
         let row = |l: usize, y: usize| (l * 3 + y % 3) * w;
         let runs = mask_row(r).unwrap_or(&full);
@@ -220,8 +231,10 @@ fn find_candidates_impl(
 /// Forms DoG row `y` of every layer into the rolling buffer at columns `c0 - 1 .. c1 + 1` (clipped to the
 /// image), and its 3-wide running max / min at columns `c0 .. c1` (`1 <= c0`, `c1 <= w - 1`).
 #[inline(always)]
+#[allow(clippy::too_many_arguments)]
 fn fill_row(
     gauss: &[Vec<f32>],
+    y0: usize,
     w: usize,
     n_dog: usize,
     rows: (&mut [f32], &mut [f32], &mut [f32]),
@@ -234,7 +247,8 @@ fn fill_row(
     for l in 0..n_dog {
         let slot = (l * 3 + y % 3) * w;
         let d = &mut dog[slot + d0..slot + d1];
-        let (a, b) = (&gauss[l][y * w + d0..y * w + d1], &gauss[l + 1][y * w + d0..y * w + d1]);
+        let o = (y - y0) * w;
+        let (a, b) = (&gauss[l][o + d0..o + d1], &gauss[l + 1][o + d0..o + d1]);
         for ((o, &x), &z) in d.iter_mut().zip(a).zip(b) {
             *o = z - x;
         }
@@ -347,8 +361,17 @@ fn solve3(mut a: [[f32; 3]; 3], mut b: [f32; 3]) -> Option<[f32; 3]> {
 }
 
 /// Refines a candidate to sub-pixel and sub-scale accuracy (Lowe 2004 §4, OpenCV `adjustLocalExtrema`)
-/// and applies the contrast and edge tests. `None` when rejected.
-pub fn refine(dog: DogView<'_>, w: usize, h: usize, cand: Candidate, params: &SiftParams) -> Option<Refined> {
+/// and applies the contrast and edge tests. `None` when rejected; [`OutOfWindow`] when a step leaves the
+/// rows the view holds.
+pub fn refine(
+    dog: DogView<'_>,
+    w: usize,
+    h: usize,
+    cand: Candidate,
+    params: &SiftParams,
+) -> Result<Option<Refined>, OutOfWindow> {
+    // Every read is at rows r - 1 ..= r + 1.
+    let inside = |r: isize| r > dog.y0 as isize && r + 1 < dog.y1 as isize;
     let img_scale = 1.0f32 / 255.0;
     let deriv_scale = img_scale * 0.5;
     let second_deriv_scale = img_scale;
@@ -359,6 +382,9 @@ pub fn refine(dog: DogView<'_>, w: usize, h: usize, cand: Candidate, params: &Si
     let (mut xi, mut xr, mut xc) = (0.0f32, 0.0f32, 0.0f32);
     let wi = w as isize;
     let mut converged = false;
+    if !inside(r) {
+        return Err(OutOfWindow);
+    }
     for _ in 0..params.max_interp_steps {
         let (img, prev, next) = (layer as usize, layer as usize - 1, layer as usize + 1);
         let at = |l: usize, rr: isize, cc: isize| dog.at(l, rr, cc);
@@ -387,7 +413,7 @@ pub fn refine(dog: DogView<'_>, w: usize, h: usize, cand: Candidate, params: &Si
         }
         let lim = (i32::MAX / 3) as f32;
         if !(xi.abs() <= lim && xr.abs() <= lim && xc.abs() <= lim) {
-            return None;
+            return Ok(None);
         }
         c += xc.round_ties_even() as isize;
         r += xr.round_ties_even() as isize;
@@ -399,11 +425,14 @@ pub fn refine(dog: DogView<'_>, w: usize, h: usize, cand: Candidate, params: &Si
             || r < border
             || r >= h as isize - border
         {
-            return None;
+            return Ok(None);
+        }
+        if !inside(r) {
+            return Err(OutOfWindow);
         }
     }
     if !converged {
-        return None;
+        return Ok(None);
     }
     let (img, prev, next) = (layer as usize, layer as usize - 1, layer as usize + 1);
     let at = |l: usize, rr: isize, cc: isize| dog.at(l, rr, cc);
@@ -415,7 +444,7 @@ pub fn refine(dog: DogView<'_>, w: usize, h: usize, cand: Candidate, params: &Si
     let t = d_d[0] * xc + d_d[1] * xr + d_d[2] * xi;
     let contr = at(img, r, c) * img_scale + t * 0.5;
     if contr.abs() * (n_layers as f32) < params.contrast_threshold {
-        return None;
+        return Ok(None);
     }
     let v2 = at(img, r, c) * 2.0;
     let dxx = (at(img, r, c + 1) + at(img, r, c - 1) - v2) * second_deriv_scale;
@@ -426,9 +455,9 @@ pub fn refine(dog: DogView<'_>, w: usize, h: usize, cand: Candidate, params: &Si
     let det = dxx * dyy - dxy * dxy;
     let et = params.edge_threshold;
     if det <= 0.0 || tr * tr * et >= (et + 1.0) * (et + 1.0) * det {
-        return None;
+        return Ok(None);
     }
-    Some(Refined { r: r as usize, c: c as usize, layer: layer as usize, xc, xr, xi, contr })
+    Ok(Some(Refined { r: r as usize, c: c as usize, layer: layer as usize, xc, xr, xi, contr }))
 }
 
 #[cfg(test)]
@@ -457,10 +486,10 @@ mod tests {
         g[2][20 * w + 31] = -3.0; // equal neighbour: still an extremum (>= test), both found
         let mut out = Vec::new();
         let mut ring = DogRows::default();
-        find_candidates(&g, w, h, 1, 1.0, 5, 0..h, None, &mut ring, &mut out);
+        find_candidates(&g, 0, w, h, 1, 1.0, 5, 0..h, None, &mut ring, &mut out);
         let mut split = Vec::new();
-        find_candidates(&g, w, h, 1, 1.0, 5, 0..13, None, &mut ring, &mut split);
-        find_candidates(&g, w, h, 1, 1.0, 5, 13..h, None, &mut ring, &mut split);
+        find_candidates(&g, 0, w, h, 1, 1.0, 5, 0..13, None, &mut ring, &mut split);
+        find_candidates(&g, 0, w, h, 1, 1.0, 5, 13..h, None, &mut ring, &mut split);
         assert_eq!(out, split);
         out.sort_by_key(|c| (c.r, c.c));
         assert_eq!(
@@ -472,7 +501,7 @@ mod tests {
             ]
         );
         out.clear();
-        find_candidates(&g, 10, 10, 1, 1.0, 5, 0..10, None, &mut ring, &mut out);
+        find_candidates(&g, 0, 10, 10, 1, 1.0, 5, 0..10, None, &mut ring, &mut out);
         assert!(out.is_empty());
     }
 }

@@ -6,22 +6,37 @@ use crate::error::SiftError;
 const MAX_SIDE: usize = 1 << 24;
 
 /// A borrowed view of a row-major f32 image (a pyramid layer, a DoG layer): its pixels and size, passed as one
-/// argument where functions took `(data, w, h, ...)`.
+/// argument where functions took `(data, w, h, ...)`. The view may hold only a window of the image's rows.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Plane<'a> {
-    /// The pixels, row-major; at least `w * h` of them.
+    /// The pixels of rows `y0 ..`, row-major.
     pub data: &'a [f32],
     /// Width, pixels.
     pub w: usize,
-    /// Height, pixels.
+    /// Height of the whole image, pixels.
     pub h: usize,
+    /// The image row `data` starts at (0 when the view holds the whole image).
+    pub y0: usize,
 }
 
 impl<'a> Plane<'a> {
     /// The view of `data` as a `w` x `h` image.
     #[inline]
     pub fn new(data: &'a [f32], w: usize, h: usize) -> Self {
-        Plane { data, w, h }
+        Plane { data, w, h, y0: 0 }
+    }
+
+    /// The view of rows `y0 ..` of a `w` x `h` image, held in `data` from its start.
+    #[inline]
+    pub fn window(data: &'a [f32], w: usize, h: usize, y0: usize) -> Self {
+        Plane { data, w, h, y0 }
+    }
+
+    /// The image rows the view holds: `y0 .. y0 + data.len() / w`, clipped to the image.
+    #[inline]
+    pub fn rows(&self) -> std::ops::Range<usize> {
+        let held = self.data.len().checked_div(self.w).unwrap_or(0);
+        self.y0..(self.y0 + held).min(self.h)
     }
 }
 

@@ -30,6 +30,8 @@ mod pyramid;
 mod sparse_tests;
 #[cfg(test)]
 mod synth;
+#[cfg(test)]
+mod window_tests;
 
 pub use error::SiftError;
 pub use image::GrayImage;
@@ -37,8 +39,7 @@ pub use keypoint::{DESCRIPTOR_LEN, Features, Keypoint};
 pub use params::SiftParams;
 
 use descriptor::DescScratch;
-use extrema::{Candidate, DogRows, DogView, find_candidates, refine};
-use image::Plane;
+use extrema::{Candidate, DogRows, DogView, OutOfWindow, find_candidates, refine};
 use orientation::{ORI_HIST_BINS, ORI_RADIUS, ORI_SIG_FCTR, OriScratch, orientation_hist, peak_angles};
 use pyramid::Octave;
 use rayon::prelude::*;
@@ -61,6 +62,8 @@ pub struct Sift {
     dog_rows: DogRows,
     ori: OriScratch,
     desc: DescScratch,
+    /// Tests only: the windowed octave's margin and rows instead of the ones the parameters give.
+    window: Option<(usize, usize)>,
 }
 
 /// A keypoint with its descriptor, before deduplication.
@@ -84,6 +87,7 @@ impl Sift {
             dog_rows: DogRows::default(),
             ori: OriScratch::default(),
             desc: DescScratch::default(),
+            window: None,
         }
     }
 
@@ -113,11 +117,16 @@ impl Sift {
             return Features::default();
         }
         let threshold = p.pre_threshold();
+        let windowed = !p.parallel;
+        let (margin, rows) = self.window.unwrap_or_else(|| {
+            let m = window_margin(&p);
+            (m, window_rows(m))
+        });
         self.octave.prepare(&p);
-        self.octave.init_base(&img.data, w, h, &p);
+        self.octave.init_base(&img.data, w, h, &p, windowed);
         let mut found: Vec<Found> = Vec::new();
         for o in 0..n_octaves as usize {
-            if o > 0 && !self.octave.next_base(p.n_octave_layers) {
+            if o > 0 && !self.octave.next_base(p.n_octave_layers, windowed) {
                 break;
             }
             if o >= 31 {
@@ -126,20 +135,23 @@ impl Sift {
             let (ow, oh) = (self.octave.w, self.octave.h);
             self.octave.plan(threshold, p.border);
             self.candidates.clear();
-            let (cands, ring) = (&mut self.candidates, &mut self.dog_rows);
             let n_layers = p.n_octave_layers;
-            let scan = |g: &[Vec<f32>], mask: Option<&mask::ChunkMask>, r0: usize, r1: usize| {
-                find_candidates(g, ow, oh, n_layers, threshold, p.border, r0..r1, mask, ring, cands)
-            };
             if p.parallel {
                 self.octave.build(true);
-                let mut scan = scan;
-                scan(&self.octave.gauss, self.octave.scan_mask(), 0, oh);
-            } else {
-                self.octave.build_scan(scan);
-            }
-            let oct = &self.octave;
-            if p.parallel {
+                let oct = &self.octave;
+                find_candidates(
+                    &oct.gauss,
+                    0,
+                    ow,
+                    oh,
+                    n_layers,
+                    threshold,
+                    p.border,
+                    0..oh,
+                    oct.scan_mask(),
+                    &mut self.dog_rows,
+                    &mut self.candidates,
+                );
                 let per: Vec<Vec<Found>> = self
                     .candidates
                     .par_iter()
@@ -147,18 +159,69 @@ impl Sift {
                         || (OriScratch::default(), DescScratch::default(), Vec::new()),
                         |(ori, desc, angles), &cand| {
                             let mut v = Vec::new();
-                            process_candidate(oct, o, cand, &p, ori, desc, angles, &mut v);
+                            // A whole octave holds every row: nothing is out of the window.
+                            let _ = process_candidate(oct, o, cand, &p, ori, desc, angles, &mut v);
                             v
                         },
                     )
                     .collect();
                 found.extend(per.into_iter().flatten());
-            } else {
-                let mut angles = Vec::new();
-                for &cand in &self.candidates {
-                    process_candidate(oct, o, cand, &p, &mut self.ori, &mut self.desc, &mut angles, &mut found);
-                }
+                continue;
             }
+            // The wavefront: candidates are refined and described as soon as the rows around them are final,
+            // so the layers need hold only a window of rows. One whose refinement steps out of the window
+            // (rare) is done again on the whole octave, and its keypoints keep their place in the order.
+            let (cands, ring, ori, desc) = (&mut self.candidates, &mut self.dog_rows, &mut self.ori, &mut self.desc);
+            let (mut next, mut angles, mut deferred) = (0, Vec::new(), Vec::new());
+            let mut tagged: Vec<(usize, Found)> = Vec::new();
+            let mut out = Vec::new();
+            self.octave.build_scan(rows, n_layers, |oct, r0, r1| {
+                find_candidates(
+                    &oct.gauss,
+                    oct.y0,
+                    ow,
+                    oh,
+                    n_layers,
+                    threshold,
+                    p.border,
+                    r0..r1,
+                    oct.scan_mask(),
+                    ring,
+                    cands,
+                );
+                let last = r1 >= oh;
+                while let Some(&cand) = cands.get(next) {
+                    if !last && cand.r + margin > r1 {
+                        break;
+                    }
+                    match process_candidate(oct, o, cand, &p, ori, desc, &mut angles, &mut out) {
+                        Ok(()) => tagged.extend(out.drain(..).map(|f| (next, f))),
+                        Err(OutOfWindow) => deferred.push(next),
+                    }
+                    next += 1;
+                }
+                cands.get(next).map_or(r1, |c| c.r.min(r1)).saturating_sub(margin)
+            });
+            if !deferred.is_empty() {
+                self.octave.rebuild_whole();
+                for &i in &deferred {
+                    let cand = self.candidates[i];
+                    let r = process_candidate(
+                        &self.octave,
+                        o,
+                        cand,
+                        &p,
+                        &mut self.ori,
+                        &mut self.desc,
+                        &mut angles,
+                        &mut out,
+                    );
+                    debug_assert!(r.is_ok(), "a whole octave holds every row");
+                    tagged.extend(out.drain(..).map(|f| (i, f)));
+                }
+                tagged.sort_by_key(|t| t.0);
+            }
+            found.extend(tagged.into_iter().map(|t| t.1));
         }
         // Back to input-image coordinates (OpenCV: firstOctave = -1 halves positions and sizes).
         if first_octave < 0 {
@@ -214,7 +277,28 @@ fn keypoint_order(a: &Keypoint, b: &Keypoint) -> Ordering {
         .then(b.octave.cmp(&a.octave))
 }
 
+/// Rows a windowed octave keeps around a candidate: those its refinement (a few steps of a pixel or so), its
+/// orientation histogram and its descriptor read at the largest scale a keypoint of the octave can have.
+fn window_margin(p: &SiftParams) -> usize {
+    let scl = p.sigma * 2f32.powf((p.n_octave_layers as f32 + 0.5) / p.n_octave_layers as f32);
+    let desc = (descriptor::DESCR_SCL_FCTR * scl * std::f32::consts::SQRT_2 * (descriptor::D as f32 + 1.0) * 0.5)
+        .round_ties_even();
+    let ori = (ORI_RADIUS * scl).round_ties_even();
+    // A large sigma is not worth a window: the layers are held whole.
+    if !desc.is_finite() || desc > 1000.0 {
+        return usize::MAX / 4;
+    }
+    desc.max(ori) as usize + 1 + 8
+}
+
+/// Rows of a layer a windowed octave holds: three times what the wavefront keeps at once (the candidates'
+/// margin on both sides and the blurs' lag), so a slide moves each row about half a time.
+fn window_rows(margin: usize) -> usize {
+    margin.saturating_mul(6).saturating_add(256)
+}
+
 /// Refines one candidate, assigns its orientations and computes one descriptor per orientation.
+/// [`OutOfWindow`] when the rows it reads are not all held (a windowed octave).
 #[allow(clippy::too_many_arguments)]
 fn process_candidate(
     oct: &Octave,
@@ -225,10 +309,11 @@ fn process_candidate(
     desc: &mut DescScratch,
     angles: &mut Vec<f32>,
     out: &mut Vec<Found>,
-) {
+) -> Result<(), OutOfWindow> {
     let (w, h) = (oct.w, oct.h);
-    let Some(rf) = refine(DogView { gauss: &oct.gauss, w }, w, h, cand, p) else {
-        return;
+    let held = oct.held();
+    let Some(rf) = refine(DogView { gauss: &oct.gauss, w, y0: held.start, y1: held.end }, w, h, cand, p)? else {
+        return Ok(());
     };
     let n_layers = p.n_octave_layers;
     let octv_scale = (1u32 << o) as f32;
@@ -243,17 +328,17 @@ fn process_candidate(
             + ((((f64::from(rf.xi) + 0.5) * 255.0).round_ties_even() as i32) << 16),
     };
     let scl_octv = base.size * 0.5 / octv_scale;
-    let gauss = oct.layer(rf.layer);
+    let ori_radius = (ORI_RADIUS * scl_octv).round_ties_even() as i32;
+    let desc_radius = descriptor::radius(scl_octv, w, h);
+    // The histograms read rows r - radius - 1 ..= r + radius + 1, inside the image.
+    let reach = (ori_radius.max(0) as usize).max(desc_radius) + 1;
+    let (lo, hi) = (rf.r.saturating_sub(reach), (rf.r + reach + 1).min(h));
+    if lo < held.start || hi > held.end {
+        return Err(OutOfWindow);
+    }
+    let gauss = oct.plane(rf.layer);
     let mut hist = [0.0f32; ORI_HIST_BINS];
-    let omax = orientation_hist(
-        Plane::new(gauss, w, h),
-        rf.c,
-        rf.r,
-        (ORI_RADIUS * scl_octv).round_ties_even() as i32,
-        ORI_SIG_FCTR * scl_octv,
-        &mut hist,
-        ori,
-    );
+    let omax = orientation_hist(gauss, rf.c, rf.r, ori_radius, ORI_SIG_FCTR * scl_octv, &mut hist, ori);
     angles.clear();
     peak_angles(&hist, omax, angles);
     let (px, py) = (rf.c as f32 + rf.xc, rf.r as f32 + rf.xr);
@@ -265,9 +350,10 @@ fn process_candidate(
         }
         let mut d = [0u8; DESCRIPTOR_LEN];
         let at = descriptor::Frame { px, py, ori: d_angle, scl: scl_octv };
-        descriptor::descriptor(Plane::new(gauss, w, h), at, &mut d, desc);
+        descriptor::descriptor(gauss, at, &mut d, desc);
         out.push((kp, d));
     }
+    Ok(())
 }
 
 #[cfg(test)]

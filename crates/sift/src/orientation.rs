@@ -48,7 +48,7 @@ fn orientation_hist_impl(
     hist: &mut [f32; ORI_HIST_BINS],
     s: &mut OriScratch,
 ) -> f32 {
-    let Plane { data: img, w, h } = img;
+    let Plane { data: img, w, h, y0 } = img;
     let n = ORI_HIST_BINS;
     let expf_scale = -1.0 / (2.0 * sigma * sigma);
     let radius = radius.max(0) as isize;
@@ -64,7 +64,7 @@ fn orientation_hist_impl(
             continue;
         }
         let wy = s.ex[i.unsigned_abs()];
-        let row = yy as usize * w;
+        let row = (yy as usize - y0) * w;
         let x0 = (xi - radius).max(1);
         let x1 = (xi + radius).min(w as isize - 2);
         for xx in x0..=x1 {

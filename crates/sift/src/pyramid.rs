@@ -3,6 +3,10 @@
 //! One octave is held at a time; its buffers are sized for the first (largest) octave and reused (never
 //! shrunk, so a reused `Sift` does not touch fresh memory). DoG images are not stored: a DoG value is the
 //! difference of two Gaussian layers, formed where it is needed (see `extrema`).
+//!
+//! The wavefront build ([`Octave::build_scan`]) holds only a window of each layer's rows, sliding down the
+//! octave: the doubled first octave of a 1200x950 map is 4.4 Mpx a layer, and touching memory for the first
+//! time costs a VM about as much as blurring it (`benchmarks/runs/2026-12-03-sift-row-window.md`).
 
 use crate::blur::{BlurScratch, Kernel, Sparse, blur, blur_band};
 use crate::image::Plane;
@@ -21,17 +25,27 @@ pub struct Octave {
     pub gauss: Vec<Vec<f32>>,
     /// Kernels blurring `gauss[i - 1]` into `gauss[i]` (index 0 unused).
     kernels: Vec<Kernel>,
-    /// Spare image buffer (upscaling, next octave's base).
+    /// The image `gauss[0]` is blurred from: the (doubled) input for the first octave, the previous octave's
+    /// layer `n_layers` halved for the others.
     spare: Vec<f32>,
+    /// The next octave's base, made while a windowed build runs (the layer it comes from is not kept).
+    next: Vec<f32>,
+    /// The image row the layer buffers start at (0 unless a windowed build slid down).
+    pub y0: usize,
+    /// Rows `y0 .. held` are final in every layer.
+    held: usize,
+    /// `next` holds the next octave's base (the last build was [`Octave::build_scan`]).
+    next_made: bool,
     /// Scratch of the blur.
     scratch: BlurScratch,
-    /// Scratch of the upscaling (horizontally doubled rows).
+    /// Scratch of the upscaling (two horizontally doubled rows).
     up_rows: Vec<f32>,
     /// Skip the constant parts of the images (see `mask`); false computes every pixel (same result).
     pub sparse: bool,
     /// This octave uses the masks (`sparse` and its base is mostly constant).
     masked: bool,
-    /// Per layer `i >= 1`: chunks where blurring `gauss[i - 1]` into `gauss[i]` must compute.
+    /// Per layer `i >= 1`: chunks where blurring `gauss[i - 1]` into `gauss[i]` must compute (layer 0: blurring
+    /// `spare` into it).
     vert: Vec<ChunkMask>,
     out: Vec<ChunkMask>,
     /// Active pixels of the current layer while planning (and of `gauss[0]` after `init_base` / `next_base`).
@@ -186,9 +200,10 @@ impl Octave {
         self.out.resize_with(n + 3, ChunkMask::default);
     }
 
-    /// Builds the first octave's base image `gauss[0]` from the input (doubling it if asked) and blurs it
-    /// from the assumed `init_sigma` to `sigma`.
-    pub fn init_base(&mut self, data: &[f32], w: usize, h: usize, params: &SiftParams) {
+    /// Prepares the first octave's base from the input (doubling it if asked): the image `gauss[0]` is blurred
+    /// from and the blur from the assumed `init_sigma` to `sigma`. Unless `windowed` (then
+    /// [`Octave::build_scan`] makes it row by row), `gauss[0]` is blurred here.
+    pub fn init_base(&mut self, data: &[f32], w: usize, h: usize, params: &SiftParams, windowed: bool) {
         let (sigma, init) = (params.sigma, params.init_sigma);
         let (bw, bh, sig_diff) = if params.upscale {
             upscale2x(data, w, h, &mut self.spare, &mut self.up_rows);
@@ -201,8 +216,6 @@ impl Octave {
         self.w = bw;
         self.h = bh;
         let kernel = Kernel::gaussian(f64::from(sig_diff));
-        let base = &mut self.gauss[0];
-        ensure_len(base, bw * bh);
         self.masked = false;
         if self.sparse {
             // Upscaled pixels only repeat constants where the input does: derive their edge mask from the
@@ -218,34 +231,54 @@ impl Octave {
         }
         if self.masked {
             self.level.copy_from(&self.base_edges);
-            let (mut vert, mut out) = (ChunkMask::default(), ChunkMask::default());
-            grow(&mut self.tmp, &mut self.level, kernel.radius(), &mut vert, &mut out);
-            let sp = Sparse { vert: &vert, out: &out };
-            blur(Plane::new(&self.spare, bw, bh), base, &kernel, &mut self.scratch, params.parallel, Some(sp));
-        } else {
-            blur(Plane::new(&self.spare, bw, bh), base, &kernel, &mut self.scratch, params.parallel, None);
+            grow(&mut self.tmp, &mut self.level, kernel.radius(), &mut self.vert[0], &mut self.out[0]);
         }
         self.base_kernel = kernel;
+        if !windowed {
+            self.base_whole(params.parallel);
+        }
+    }
+
+    /// Makes `gauss[0]` whole from `spare`, the layer buffers holding the whole octave.
+    fn base_whole(&mut self, parallel: bool) {
+        let n = self.w * self.h;
+        self.y0 = 0;
+        ensure_len(&mut self.gauss[0], n);
+        if self.base_kernel.radius() == 0 {
+            self.gauss[0][..n].copy_from_slice(&self.spare[..n]);
+        } else {
+            let sp = self.masked.then(|| Sparse { vert: &self.vert[0], out: &self.out[0] });
+            let src = Plane::new(&self.spare, self.w, self.h);
+            blur(src, &mut self.gauss[0], &self.base_kernel, &mut self.scratch, parallel, sp);
+        }
     }
 
     /// Makes the next octave's base: `gauss[n_layers]` of this octave, every second pixel (OpenCV
-    /// `INTER_NEAREST` resize to half size). Returns false when the image would become empty.
-    pub fn next_base(&mut self, n_layers: usize) -> bool {
+    /// `INTER_NEAREST` resize to half size; a windowed build made it already). Unless `windowed`, `gauss[0]` is
+    /// made here. Returns false when the image would become empty.
+    pub fn next_base(&mut self, n_layers: usize, windowed: bool) -> bool {
         let (w, h) = (self.w / 2, self.h / 2);
         if w == 0 || h == 0 {
             return false;
         }
-        downsample_nearest(&self.gauss[n_layers], self.w, self.h, w, h, &mut self.spare);
-        std::mem::swap(&mut self.spare, &mut self.gauss[0]);
+        if self.next_made {
+            // The wavefront halved the layer as it went (a window of it is all that is left).
+            std::mem::swap(&mut self.spare, &mut self.next);
+        } else {
+            downsample_nearest(&self.gauss[n_layers], self.w, self.h, w, h, &mut self.spare);
+        }
         self.w = w;
         self.h = h;
         self.masked = false;
         if self.sparse {
-            self.base_flat = self.base_edges.edges_of(&self.gauss[0][..w * h], w, h);
+            self.base_flat = self.base_edges.edges_of(&self.spare[..w * h], w, h);
             self.masked = self.base_flat.density <= MAX_EDGE_DENSITY;
             self.level.copy_from(&self.base_edges);
         }
         self.base_kernel = Kernel { half: vec![1.0] };
+        if !windowed {
+            self.base_whole(false);
+        }
         true
     }
 
@@ -307,7 +340,7 @@ impl Octave {
         self.scan.as_ref()
     }
 
-    /// Blurs `gauss[0]` into the remaining layers.
+    /// Blurs `gauss[0]` into the remaining layers, whole.
     pub fn build(&mut self, parallel: bool) {
         let n = self.w * self.h;
         for i in 1..self.gauss.len() {
@@ -317,41 +350,103 @@ impl Octave {
             let sp = self.masked.then(|| Sparse { vert: &self.vert[i], out: &self.out[i] });
             blur(Plane::new(&done[i - 1], self.w, self.h), dst, &self.kernels[i], &mut self.scratch, parallel, sp);
         }
+        (self.y0, self.held, self.next_made) = (0, self.h, false);
     }
 
-    /// Blurs `gauss[0]` into the remaining layers as a wavefront of row bands, so each layer's rows are
-    /// read back (by the next layer's blur and by `scan`) while still in cache. `scan(gauss, mask, r0, r1)`
-    /// is called with consecutive row ranges `0..r1` whose Gaussian rows up to `r1` (inclusive) are final
-    /// in every layer. Same result as [`Octave::build`] followed by one scan of all rows.
-    pub fn build_scan(&mut self, mut scan: impl FnMut(&[Vec<f32>], Option<&ChunkMask>, usize, usize)) {
+    /// Builds the whole octave again, every layer whole, after a windowed [`Octave::build_scan`] (for the rare
+    /// keypoint whose refinement left the window).
+    pub fn rebuild_whole(&mut self) {
+        self.base_whole(false);
+        let next_made = self.next_made;
+        self.build(false);
+        self.next_made = next_made;
+    }
+
+    /// Makes the layers as a wavefront of row bands, so each layer's rows are read back (by the next layer's
+    /// blur and by `step`) while still in cache, holding at most about `window` rows of each layer (all of
+    /// them when the octave is shorter): the window slides down the octave. `step(octave, r0, r1)` is called
+    /// with consecutive row ranges `0..r1` whose rows up to `r1` (inclusive) are final in every layer, and
+    /// returns the lowest row it will still read; [`Octave::held`] says which rows it may read now. Also
+    /// makes the next octave's base. Same values as [`Octave::build`], bit for bit.
+    pub fn build_scan(&mut self, window: usize, n_layers: usize, mut step: impl FnMut(&Octave, usize, usize) -> usize) {
         const BAND: usize = 16;
         let (w, h) = (self.w, self.h);
-        let n = w * h;
         let layers = self.gauss.len();
-        for g in &mut self.gauss[1..] {
-            ensure_len(g, n);
+        if w == 0 || h == 0 {
+            return;
         }
+        let radii: Vec<usize> =
+            (0..layers).map(|i| if i == 0 { self.base_kernel.radius() } else { self.kernels[i].radius() }).collect();
+        let mut cap = window.clamp(BAND, h.max(BAND)).min(h);
+        for g in &mut self.gauss {
+            ensure_len(g, cap * w);
+        }
+        (self.y0, self.held, self.next_made) = (0, 0, true);
+        let (nw, nh) = (w / 2, h / 2);
+        let (xs, ys) = (nearest_indices(w, nw), nearest_indices(h, nh));
+        ensure_len(&mut self.next, nw * nh);
+        let mut next_done = 0;
         let mut avail = vec![0usize; layers];
-        avail[0] = h;
-        let mut scanned = 0;
+        let (mut scanned, mut keep) = (0usize, 0usize);
         loop {
-            for i in 1..layers {
-                let r = self.kernels[i].radius();
-                let ready = if avail[i - 1] >= h { h } else { avail[i - 1].saturating_sub(r) };
+            for i in 0..layers {
+                let src_avail = if i == 0 { h } else { avail[i - 1] };
+                let ready = if src_avail >= h { h } else { src_avail.saturating_sub(radii[i]) };
                 let target = ready.min(avail[i] + BAND);
-                if target > avail[i] {
+                if target <= avail[i] {
+                    continue;
+                }
+                if target > self.y0 + cap {
+                    // Slide: drop the rows nobody reads any more (the step, the blurs of the next layers, the
+                    // next octave's base), then grow the window if that was not enough.
+                    let mut from = keep.min(scanned.saturating_sub(1));
+                    if let Some(&y) = ys.get(next_done) {
+                        from = from.min(y);
+                    }
+                    for j in 1..layers {
+                        from = from.min(avail[j].saturating_sub(radii[j]));
+                    }
+                    if from > self.y0 {
+                        let shift = (from - self.y0) * w;
+                        for (g, &a) in self.gauss.iter_mut().zip(&avail) {
+                            g.copy_within(shift..(a - self.y0) * w, 0);
+                        }
+                        self.y0 = from;
+                    }
+                    if target > self.y0 + cap {
+                        cap = (2 * cap).max(target - self.y0).min(h);
+                        for g in &mut self.gauss {
+                            ensure_len(g, cap * w);
+                        }
+                    }
+                }
+                if i == 0 {
+                    self.base_rows(avail[0], target);
+                } else {
                     let (done, rest) = self.gauss.split_at_mut(i);
                     let sp = self.masked.then(|| Sparse { vert: &self.vert[i], out: &self.out[i] });
-                    let k = &self.kernels[i];
-                    blur_band(Plane::new(&done[i - 1], w, h), &mut rest[0], avail[i], target, k, &mut self.scratch, sp);
-                    avail[i] = target;
+                    let src = Plane::window(&done[i - 1], w, h, self.y0);
+                    let (k, sc) = (&self.kernels[i], &mut self.scratch);
+                    blur_band(src, &mut rest[0], self.y0, avail[i], target, k, sc, sp);
                 }
+                avail[i] = target;
+            }
+            while let Some(&sy) = ys.get(next_done) {
+                if sy >= avail[n_layers] {
+                    break;
+                }
+                let row = &self.gauss[n_layers][(sy - self.y0) * w..(sy - self.y0 + 1) * w];
+                for (o, &sx) in self.next[next_done * nw..(next_done + 1) * nw].iter_mut().zip(&xs) {
+                    *o = row[sx];
+                }
+                next_done += 1;
             }
             let all = avail.iter().copied().min().unwrap_or(h);
+            self.held = all;
             // Rows whose neighbours (one row below) are final in every layer.
             let upto = if all >= h { h } else { all.saturating_sub(1) };
             if upto > scanned {
-                scan(&self.gauss, self.scan.as_ref(), scanned, upto);
+                keep = step(self, scanned, upto);
                 scanned = upto;
             }
             if all >= h {
@@ -360,9 +455,31 @@ impl Octave {
         }
     }
 
-    /// Gaussian layer `i` of this octave (`w * h` values).
+    /// Rows `y0 .. y1` of `gauss[0]` (window from `self.y0`), from `spare`.
+    fn base_rows(&mut self, y0: usize, y1: usize) {
+        let (w, o) = (self.w, self.y0);
+        if self.base_kernel.radius() == 0 {
+            self.gauss[0][(y0 - o) * w..(y1 - o) * w].copy_from_slice(&self.spare[y0 * w..y1 * w]);
+        } else {
+            let sp = self.masked.then(|| Sparse { vert: &self.vert[0], out: &self.out[0] });
+            let src = Plane::new(&self.spare[..w * self.h], w, self.h);
+            blur_band(src, &mut self.gauss[0], o, y0, y1, &self.base_kernel, &mut self.scratch, sp);
+        }
+    }
+
+    /// The rows final in every layer, held from the start of the layer buffers at row [`Octave::y0`].
+    pub fn held(&self) -> std::ops::Range<usize> {
+        self.y0..self.held
+    }
+
+    /// Gaussian layer `i` of this octave: the rows [`Octave::held`] from its start.
     pub fn layer(&self, i: usize) -> &[f32] {
-        &self.gauss[i][..self.w * self.h]
+        &self.gauss[i][..(self.held - self.y0) * self.w]
+    }
+
+    /// Gaussian layer `i` as a view of the rows [`Octave::held`].
+    pub fn plane(&self, i: usize) -> Plane<'_> {
+        Plane::window(self.layer(i), self.w, self.h, self.y0)
     }
 }
 
@@ -386,29 +503,32 @@ fn grow(tmp: &mut BitMask, level: &mut BitMask, r: usize, vert: &mut ChunkMask, 
 }
 
 /// OpenCV `resize(.., 2x size, INTER_LINEAR)`: half-pixel-centre bilinear doubling, horizontal pass first.
-/// `dst` (grown if needed) receives the `2w x 2h` image in its first values; `rows` is scratch.
+/// `dst` (grown if needed) receives the `2w x 2h` image in its first values; `rows` is scratch (two doubled
+/// source rows).
 pub fn upscale2x(src: &[f32], w: usize, h: usize, dst: &mut Vec<f32>, rows: &mut Vec<f32>) {
     let (dw, dh) = (2 * w, 2 * h);
     ensure_len(dst, dw * dh);
     if w == 0 || h == 0 {
         return;
     }
-    // Horizontal: every source row doubled.
-    ensure_len(rows, dw * h);
-    for y in 0..h {
-        let s = &src[y * w..y * w + w];
-        let d = &mut rows[y * dw..y * dw + dw];
-        hdouble(s, d);
-    }
-    // Vertical.
+    ensure_len(rows, 2 * dw);
+    // Source row y, doubled horizontally, lives in slot y % 2.
+    let mut held = [usize::MAX; 2];
     for dy in 0..dh {
-        let out = &mut dst[dy * dw..dy * dw + dw];
         let (sy, fy) = src_coord(dy, h);
-        let r0 = &rows[sy * dw..sy * dw + dw];
+        let last = if fy == 0.0 { sy } else { sy + 1 };
+        for y in sy..=last {
+            if held[y % 2] != y {
+                hdouble(&src[y * w..y * w + w], &mut rows[(y % 2) * dw..(y % 2 + 1) * dw]);
+                held[y % 2] = y;
+            }
+        }
+        let out = &mut dst[dy * dw..dy * dw + dw];
+        let r0 = &rows[(sy % 2) * dw..(sy % 2 + 1) * dw];
         if fy == 0.0 {
             out.copy_from_slice(r0);
         } else {
-            let r1 = &rows[(sy + 1) * dw..(sy + 1) * dw + dw];
+            let r1 = &rows[((sy + 1) % 2) * dw..((sy + 1) % 2 + 1) * dw];
             let (b0, b1) = (1.0 - fy, fy);
             for ((o, &a), &b) in out.iter_mut().zip(r0).zip(r1) {
                 *o = a * b0 + b * b1;
@@ -448,16 +568,19 @@ fn hdouble(s: &[f32], d: &mut [f32]) {
 /// OpenCV `resize(.., INTER_NEAREST)` from `w x h` to `dw x dh` (into the first values of `dst`).
 pub fn downsample_nearest(src: &[f32], w: usize, h: usize, dw: usize, dh: usize, dst: &mut Vec<f32>) {
     ensure_len(dst, dw * dh);
-    let ifx = 1.0 / (dw as f64 / w as f64);
-    let ify = 1.0 / (dh as f64 / h as f64);
-    let xs: Vec<usize> = (0..dw).map(|x| ((x as f64 * ifx).floor() as usize).min(w - 1)).collect();
-    for y in 0..dh {
-        let sy = ((y as f64 * ify).floor() as usize).min(h - 1);
+    let xs = nearest_indices(w, dw);
+    for (y, sy) in nearest_indices(h, dh).into_iter().enumerate() {
         let s = &src[sy * w..sy * w + w];
         for (o, &sx) in dst[y * dw..y * dw + dw].iter_mut().zip(&xs) {
             *o = s[sx];
         }
     }
+}
+
+/// Source index of each of `dn` samples resizing a line of `n` with `INTER_NEAREST`.
+fn nearest_indices(n: usize, dn: usize) -> Vec<usize> {
+    let inv = 1.0 / (dn as f64 / n as f64);
+    (0..dn).map(|d| ((d as f64 * inv).floor() as usize).min(n.saturating_sub(1))).collect()
 }
 
 #[cfg(test)]
@@ -488,12 +611,12 @@ mod tests {
         let p = SiftParams::default();
         let mut o = Octave::default();
         o.prepare(&p);
-        o.init_base(&vec![10.0; 64], 8, 8, &p);
+        o.init_base(&vec![10.0; 64], 8, 8, &p, false);
         o.plan(1.0, 5);
         o.build(false);
         assert_eq!((o.w, o.h, o.gauss.len()), (16, 16, 6));
         assert!((0..6).all(|i| o.layer(i).iter().all(|v| (v - 10.0).abs() < 1e-3)));
-        assert!(o.next_base(3));
+        assert!(o.next_base(3, false));
         assert_eq!((o.w, o.h), (8, 8));
     }
 }

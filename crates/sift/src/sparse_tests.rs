@@ -7,7 +7,7 @@ use crate::{Features, GrayImage, Sift, SiftParams};
 use crate::synth;
 
 /// Panics with the first difference between two feature sets.
-fn assert_identical(sparse: &Features, dense: &Features, what: &str) {
+pub(crate) fn assert_identical(sparse: &Features, dense: &Features, what: &str) {
     assert_eq!(sparse.keypoints.len(), dense.keypoints.len(), "{what}: keypoint count");
     for (i, (a, b)) in sparse.keypoints.iter().zip(&dense.keypoints).enumerate() {
         let bits = |k: &crate::Keypoint| {
@@ -19,7 +19,7 @@ fn assert_identical(sparse: &Features, dense: &Features, what: &str) {
 }
 
 /// Images with large constant areas, textures, noise and awkward values.
-fn images() -> Vec<(String, GrayImage)> {
+pub(crate) fn images() -> Vec<(String, GrayImage)> {
     let mut out = Vec::new();
     let u8_img = |w: usize, h: usize, d: Vec<u8>| GrayImage::from_u8(w, h, &d).expect("valid image");
     for (w, h, seed) in [(300usize, 240usize, 1u64), (181, 317, 2), (96, 70, 3)] {
