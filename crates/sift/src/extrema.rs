@@ -55,9 +55,30 @@ impl DogView<'_> {
     }
 }
 
-/// A refinement stepped to rows the view does not hold (a windowed octave): redo it on the whole octave.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct OutOfWindow;
+/// Where a refinement stands: the pixel and layer it is at, the steps it has taken, and once converged, the
+/// offsets. A refinement that needs rows its view does not hold (a windowed octave) returns its state, to be
+/// resumed, bit for bit the same, where they are held.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RefineState {
+    r: isize,
+    c: isize,
+    layer: isize,
+    step: usize,
+    /// `(xi, xr, xc)` once converged.
+    offsets: Option<[f32; 3]>,
+}
+
+impl RefineState {
+    /// A refinement about to take its first step at a candidate.
+    pub fn start(cand: Candidate) -> Self {
+        Self { r: cand.r as isize, c: cand.c as isize, layer: cand.layer as isize, step: 0, offsets: None }
+    }
+
+    /// The rows the next step reads.
+    pub fn rows(&self) -> std::ops::Range<usize> {
+        (self.r - 1).max(0) as usize..(self.r + 2).max(0) as usize
+    }
+}
 
 /// Columns tested together (the scan mask's chunks).
 const CHUNK: usize = crate::mask::CHUNK;
@@ -361,15 +382,15 @@ fn solve3(mut a: [[f32; 3]; 3], mut b: [f32; 3]) -> Option<[f32; 3]> {
 }
 
 /// Refines a candidate to sub-pixel and sub-scale accuracy (Lowe 2004 §4, OpenCV `adjustLocalExtrema`)
-/// and applies the contrast and edge tests. `None` when rejected; [`OutOfWindow`] when a step leaves the
-/// rows the view holds.
+/// and applies the contrast and edge tests, from `state` on. `Ok(None)` when rejected; `Err` with the state
+/// reached when the next step reads rows the view does not hold.
 pub fn refine(
     dog: DogView<'_>,
     w: usize,
     h: usize,
-    cand: Candidate,
+    state: RefineState,
     params: &SiftParams,
-) -> Result<Option<Refined>, OutOfWindow> {
+) -> Result<Option<Refined>, RefineState> {
     // Every read is at rows r - 1 ..= r + 1.
     let inside = |r: isize| r > dog.y0 as isize && r + 1 < dog.y1 as isize;
     let img_scale = 1.0f32 / 255.0;
@@ -378,61 +399,60 @@ pub fn refine(
     let cross_deriv_scale = img_scale * 0.25;
     let n_layers = params.n_octave_layers;
     let border = params.border as isize;
-    let (mut r, mut c, mut layer) = (cand.r as isize, cand.c as isize, cand.layer as isize);
-    let (mut xi, mut xr, mut xc) = (0.0f32, 0.0f32, 0.0f32);
+    let RefineState { mut r, mut c, mut layer, step, mut offsets } = state;
     let wi = w as isize;
-    let mut converged = false;
-    if !inside(r) {
-        return Err(OutOfWindow);
-    }
-    for _ in 0..params.max_interp_steps {
-        let (img, prev, next) = (layer as usize, layer as usize - 1, layer as usize + 1);
-        let at = |l: usize, rr: isize, cc: isize| dog.at(l, rr, cc);
-        let d_d = [
-            (at(img, r, c + 1) - at(img, r, c - 1)) * deriv_scale,
-            (at(img, r + 1, c) - at(img, r - 1, c)) * deriv_scale,
-            (at(next, r, c) - at(prev, r, c)) * deriv_scale,
-        ];
-        let v2 = at(img, r, c) * 2.0;
-        let dxx = (at(img, r, c + 1) + at(img, r, c - 1) - v2) * second_deriv_scale;
-        let dyy = (at(img, r + 1, c) + at(img, r - 1, c) - v2) * second_deriv_scale;
-        let dss = (at(next, r, c) + at(prev, r, c) - v2) * second_deriv_scale;
-        let dxy = (at(img, r + 1, c + 1) - at(img, r + 1, c - 1) - at(img, r - 1, c + 1) + at(img, r - 1, c - 1))
-            * cross_deriv_scale;
-        let dxs =
-            (at(next, r, c + 1) - at(next, r, c - 1) - at(prev, r, c + 1) + at(prev, r, c - 1)) * cross_deriv_scale;
-        let dys =
-            (at(next, r + 1, c) - at(next, r - 1, c) - at(prev, r + 1, c) + at(prev, r - 1, c)) * cross_deriv_scale;
-        let x = solve3([[dxx, dxy, dxs], [dxy, dyy, dys], [dxs, dys, dss]], d_d).unwrap_or([0.0; 3]);
-        xi = -x[2];
-        xr = -x[1];
-        xc = -x[0];
-        if xi.abs() < 0.5 && xr.abs() < 0.5 && xc.abs() < 0.5 {
-            converged = true;
-            break;
-        }
-        let lim = (i32::MAX / 3) as f32;
-        if !(xi.abs() <= lim && xr.abs() <= lim && xc.abs() <= lim) {
-            return Ok(None);
-        }
-        c += xc.round_ties_even() as isize;
-        r += xr.round_ties_even() as isize;
-        layer += xi.round_ties_even() as isize;
-        if layer < 1
-            || layer > n_layers as isize
-            || c < border
-            || c >= wi - border
-            || r < border
-            || r >= h as isize - border
-        {
-            return Ok(None);
-        }
-        if !inside(r) {
-            return Err(OutOfWindow);
+    if offsets.is_none() {
+        for step in step..params.max_interp_steps {
+            if !inside(r) {
+                return Err(RefineState { r, c, layer, step, offsets });
+            }
+            let (img, prev, next) = (layer as usize, layer as usize - 1, layer as usize + 1);
+            let at = |l: usize, rr: isize, cc: isize| dog.at(l, rr, cc);
+            let d_d = [
+                (at(img, r, c + 1) - at(img, r, c - 1)) * deriv_scale,
+                (at(img, r + 1, c) - at(img, r - 1, c)) * deriv_scale,
+                (at(next, r, c) - at(prev, r, c)) * deriv_scale,
+            ];
+            let v2 = at(img, r, c) * 2.0;
+            let dxx = (at(img, r, c + 1) + at(img, r, c - 1) - v2) * second_deriv_scale;
+            let dyy = (at(img, r + 1, c) + at(img, r - 1, c) - v2) * second_deriv_scale;
+            let dss = (at(next, r, c) + at(prev, r, c) - v2) * second_deriv_scale;
+            let dxy = (at(img, r + 1, c + 1) - at(img, r + 1, c - 1) - at(img, r - 1, c + 1) + at(img, r - 1, c - 1))
+                * cross_deriv_scale;
+            let dxs =
+                (at(next, r, c + 1) - at(next, r, c - 1) - at(prev, r, c + 1) + at(prev, r, c - 1)) * cross_deriv_scale;
+            let dys =
+                (at(next, r + 1, c) - at(next, r - 1, c) - at(prev, r + 1, c) + at(prev, r - 1, c)) * cross_deriv_scale;
+            let x = solve3([[dxx, dxy, dxs], [dxy, dyy, dys], [dxs, dys, dss]], d_d).unwrap_or([0.0; 3]);
+            let (xi, xr, xc) = (-x[2], -x[1], -x[0]);
+            if xi.abs() < 0.5 && xr.abs() < 0.5 && xc.abs() < 0.5 {
+                offsets = Some([xi, xr, xc]);
+                break;
+            }
+            let lim = (i32::MAX / 3) as f32;
+            if !(xi.abs() <= lim && xr.abs() <= lim && xc.abs() <= lim) {
+                return Ok(None);
+            }
+            c += xc.round_ties_even() as isize;
+            r += xr.round_ties_even() as isize;
+            layer += xi.round_ties_even() as isize;
+            if layer < 1
+                || layer > n_layers as isize
+                || c < border
+                || c >= wi - border
+                || r < border
+                || r >= h as isize - border
+            {
+                return Ok(None);
+            }
         }
     }
-    if !converged {
+    let Some([xi, xr, xc]) = offsets else {
         return Ok(None);
+    };
+    if !inside(r) {
+        let step = params.max_interp_steps;
+        return Err(RefineState { r, c, layer, step, offsets });
     }
     let (img, prev, next) = (layer as usize, layer as usize - 1, layer as usize + 1);
     let at = |l: usize, rr: isize, cc: isize| dog.at(l, rr, cc);
@@ -473,6 +493,33 @@ mod tests {
             assert!((got - want).abs() < 1e-5);
         }
         assert!(solve3([[0.0; 3]; 3], [1.0; 3]).is_none());
+    }
+
+    #[test]
+    fn a_refinement_stopped_at_the_window_resumes_to_the_same_answer() {
+        // DoG layer 1 is a bowl peaking at row 18.4, column 20.2: from the candidate at row 15 the first step
+        // moves three rows down, the second converges.
+        let (w, h) = (40, 40);
+        let dog = |l: usize, r: usize, c: usize| {
+            let (dr, dc, dl) = (r as f32 - 18.4, c as f32 - 20.2, l as f32 - 1.0);
+            100.0 - 2.0 * dr * dr - 2.0 * dc * dc - 8.0 * dl * dl
+        };
+        let mut g = vec![vec![0.0f32; w * h]; 4];
+        for l in 0..3 {
+            for i in 0..w * h {
+                g[l + 1][i] = g[l][i] + dog(l, i / w, i % w);
+            }
+        }
+        let p = SiftParams { n_octave_layers: 1, ..SiftParams::default() };
+        let start = RefineState::start(Candidate { r: 15, c: 20, layer: 1 });
+        let whole = DogView { gauss: &g, w, y0: 0, y1: h };
+        let want = refine(whole, w, h, start, &p).expect("all rows held").expect("kept");
+        assert_eq!((want.r, want.c, want.layer), (18, 20, 1));
+        // Rows 13..17 only: the first step runs, the second needs rows 17..20.
+        let window: Vec<Vec<f32>> = g.iter().map(|l| l[13 * w..17 * w].to_vec()).collect();
+        let stopped = refine(DogView { gauss: &window, w, y0: 13, y1: 17 }, w, h, start, &p).unwrap_err();
+        assert_eq!(stopped.rows(), 17..20);
+        assert_eq!(refine(whole, w, h, stopped, &p), Ok(Some(want)));
     }
 
     #[test]

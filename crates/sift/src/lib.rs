@@ -39,7 +39,7 @@ pub use keypoint::{DESCRIPTOR_LEN, Features, Keypoint};
 pub use params::SiftParams;
 
 use descriptor::DescScratch;
-use extrema::{Candidate, DogRows, DogView, OutOfWindow, find_candidates, refine};
+use extrema::{Candidate, DogRows, DogView, RefineState, Refined, find_candidates, refine};
 use orientation::{ORI_HIST_BINS, ORI_RADIUS, ORI_SIG_FCTR, OriScratch, orientation_hist, peak_angles};
 use pyramid::Octave;
 use rayon::prelude::*;
@@ -159,8 +159,8 @@ impl Sift {
                         || (OriScratch::default(), DescScratch::default(), Vec::new()),
                         |(ori, desc, angles), &cand| {
                             let mut v = Vec::new();
-                            // A whole octave holds every row: nothing is out of the window.
-                            let _ = process_candidate(oct, o, cand, &p, ori, desc, angles, &mut v);
+                            // A whole octave holds every row: no job waits.
+                            let _ = process_candidate(oct, o, Job::start(cand), &p, ori, desc, angles, &mut v);
                             v
                         },
                     )
@@ -169,10 +169,11 @@ impl Sift {
                 continue;
             }
             // The wavefront: candidates are refined and described as soon as the rows around them are final,
-            // so the layers need hold only a window of rows. One whose refinement steps out of the window
-            // (rare) is done again on the whole octave, and its keypoints keep their place in the order.
+            // so the layers need hold only a window of rows. A refinement that steps to rows the window no longer
+            // (or does not yet) hold waits, and is resumed in another pass down the octave (rare: a step far
+            // across a flat region); keypoints keep their candidate's place in the order.
             let (cands, ring, ori, desc) = (&mut self.candidates, &mut self.dog_rows, &mut self.ori, &mut self.desc);
-            let (mut next, mut angles, mut deferred) = (0, Vec::new(), Vec::new());
+            let (mut next, mut angles, mut waiting) = (0, Vec::new(), Vec::new());
             let mut tagged: Vec<(usize, Found)> = Vec::new();
             let mut out = Vec::new();
             self.octave.build_scan(rows, n_layers, |oct, r0, r1| {
@@ -194,31 +195,44 @@ impl Sift {
                     if !last && cand.r + margin > r1 {
                         break;
                     }
-                    match process_candidate(oct, o, cand, &p, ori, desc, &mut angles, &mut out) {
+                    match process_candidate(oct, o, Job::start(cand), &p, ori, desc, &mut angles, &mut out) {
                         Ok(()) => tagged.extend(out.drain(..).map(|f| (next, f))),
-                        Err(OutOfWindow) => deferred.push(next),
+                        Err(job) => waiting.push((next, Some(job))),
                     }
                     next += 1;
                 }
                 cands.get(next).map_or(r1, |c| c.r.min(r1)).saturating_sub(margin)
             });
-            if !deferred.is_empty() {
-                self.octave.rebuild_whole();
-                for &i in &deferred {
-                    let cand = self.candidates[i];
-                    let r = process_candidate(
-                        &self.octave,
-                        o,
-                        cand,
-                        &p,
-                        &mut self.ori,
-                        &mut self.desc,
-                        &mut angles,
-                        &mut out,
-                    );
-                    debug_assert!(r.is_ok(), "a whole octave holds every row");
-                    tagged.extend(out.drain(..).map(|f| (i, f)));
-                }
+            while !waiting.is_empty() {
+                // Another pass: each waiting job runs while the rows it reads are held; a job wanting rows above
+                // the window waits for the next pass. Every pass moves every job on, and a job takes at most
+                // `max_interp_steps` + 2 moves.
+                self.octave.build_scan(rows, n_layers, |oct, _, _| {
+                    let held = oct.held();
+                    let mut keep = usize::MAX;
+                    for (i, job) in &mut waiting {
+                        loop {
+                            let Some(j) = job else { break };
+                            let need = j.rows(&p, ow, oh);
+                            if need.start < held.start {
+                                break; // the next pass
+                            }
+                            if need.end > held.end {
+                                keep = keep.min(need.start);
+                                break;
+                            }
+                            match process_candidate(oct, o, Some(*j), &p, ori, desc, &mut angles, &mut out) {
+                                Ok(()) => {
+                                    tagged.extend(out.drain(..).map(|f| (*i, f)));
+                                    *job = None;
+                                }
+                                Err(moved) => *job = Some(moved),
+                            }
+                        }
+                    }
+                    keep.min(held.end)
+                });
+                waiting.retain(|(_, job)| job.is_some());
                 tagged.sort_by_key(|t| t.0);
             }
             found.extend(tagged.into_iter().map(|t| t.1));
@@ -297,24 +311,75 @@ fn window_rows(margin: usize) -> usize {
     margin.saturating_mul(6).saturating_add(256)
 }
 
-/// Refines one candidate, assigns its orientations and computes one descriptor per orientation.
-/// [`OutOfWindow`] when the rows it reads are not all held (a windowed octave).
+/// The work left on a candidate of a windowed octave.
+#[derive(Debug, Clone, Copy)]
+enum Job {
+    /// Refining it, from this state.
+    Refine(RefineState),
+    /// Its orientations and descriptors, refined.
+    Describe(Refined),
+}
+
+impl Job {
+    fn start(cand: Candidate) -> Option<Self> {
+        Some(Job::Refine(RefineState::start(cand)))
+    }
+
+    /// The rows the job's next move reads.
+    fn rows(&self, p: &SiftParams, w: usize, h: usize) -> std::ops::Range<usize> {
+        match self {
+            Job::Refine(st) => st.rows(),
+            Job::Describe(rf) => {
+                let reach = describe_reach(rf, p, w, h);
+                rf.r.saturating_sub(reach)..(rf.r + reach + 1).min(h)
+            }
+        }
+    }
+}
+
+/// Scale of a refined keypoint in its octave's pixels.
+fn octave_scale(rf: &Refined, p: &SiftParams) -> f32 {
+    p.sigma * 2f32.powf((rf.layer as f32 + rf.xi) / p.n_octave_layers as f32)
+}
+
+/// Rows on each side of a refined keypoint its orientation histogram and descriptor read.
+fn describe_reach(rf: &Refined, p: &SiftParams, w: usize, h: usize) -> usize {
+    let scl = octave_scale(rf, p);
+    let ori_radius = (ORI_RADIUS * scl).round_ties_even().max(0.0) as usize;
+    ori_radius.max(descriptor::radius(scl, w, h)) + 1
+}
+
+/// Refines one candidate, assigns its orientations and computes one descriptor per orientation, from `job`
+/// on (`None`: nothing to do); `Err` with the job left when its next move reads rows the octave does not hold
+/// (a windowed octave).
 #[allow(clippy::too_many_arguments)]
 fn process_candidate(
     oct: &Octave,
     o: usize,
-    cand: Candidate,
+    job: Option<Job>,
     p: &SiftParams,
     ori: &mut OriScratch,
     desc: &mut DescScratch,
     angles: &mut Vec<f32>,
     out: &mut Vec<Found>,
-) -> Result<(), OutOfWindow> {
+) -> Result<(), Job> {
     let (w, h) = (oct.w, oct.h);
     let held = oct.held();
-    let Some(rf) = refine(DogView { gauss: &oct.gauss, w, y0: held.start, y1: held.end }, w, h, cand, p)? else {
-        return Ok(());
+    let rf = match job {
+        None => return Ok(()),
+        Some(Job::Describe(rf)) => rf,
+        Some(Job::Refine(st)) => {
+            match refine(DogView { gauss: &oct.gauss, w, y0: held.start, y1: held.end }, w, h, st, p) {
+                Ok(Some(rf)) => rf,
+                Ok(None) => return Ok(()),
+                Err(st) => return Err(Job::Refine(st)),
+            }
+        }
     };
+    let need = Job::Describe(rf).rows(p, w, h);
+    if need.start < held.start || need.end > held.end {
+        return Err(Job::Describe(rf));
+    }
     let n_layers = p.n_octave_layers;
     let octv_scale = (1u32 << o) as f32;
     let base = Keypoint {
@@ -328,16 +393,9 @@ fn process_candidate(
             + ((((f64::from(rf.xi) + 0.5) * 255.0).round_ties_even() as i32) << 16),
     };
     let scl_octv = base.size * 0.5 / octv_scale;
-    let ori_radius = (ORI_RADIUS * scl_octv).round_ties_even() as i32;
-    let desc_radius = descriptor::radius(scl_octv, w, h);
-    // The histograms read rows r - radius - 1 ..= r + radius + 1, inside the image.
-    let reach = (ori_radius.max(0) as usize).max(desc_radius) + 1;
-    let (lo, hi) = (rf.r.saturating_sub(reach), (rf.r + reach + 1).min(h));
-    if lo < held.start || hi > held.end {
-        return Err(OutOfWindow);
-    }
     let gauss = oct.plane(rf.layer);
     let mut hist = [0.0f32; ORI_HIST_BINS];
+    let ori_radius = (ORI_RADIUS * scl_octv).round_ties_even() as i32;
     let omax = orientation_hist(gauss, rf.c, rf.r, ori_radius, ORI_SIG_FCTR * scl_octv, &mut hist, ori);
     angles.clear();
     peak_angles(&hist, omax, angles);

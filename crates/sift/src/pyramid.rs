@@ -353,15 +353,6 @@ impl Octave {
         (self.y0, self.held, self.next_made) = (0, self.h, false);
     }
 
-    /// Builds the whole octave again, every layer whole, after a windowed [`Octave::build_scan`] (for the rare
-    /// keypoint whose refinement left the window).
-    pub fn rebuild_whole(&mut self) {
-        self.base_whole(false);
-        let next_made = self.next_made;
-        self.build(false);
-        self.next_made = next_made;
-    }
-
     /// Makes the layers as a wavefront of row bands, so each layer's rows are read back (by the next layer's
     /// blur and by `step`) while still in cache, holding at most about `window` rows of each layer (all of
     /// them when the octave is shorter): the window slides down the octave. `step(octave, r0, r1)` is called

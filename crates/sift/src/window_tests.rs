@@ -1,7 +1,7 @@
 //! The windowed wavefront (the layers hold a sliding window of rows, keypoints made as the rows around them
 //! become final) gives exactly the output of whole layers, bit for bit: with the window the parameters give,
 //! with windows so small they slide every band and must grow, and with margins so small that refinements
-//! step out of the window and are redone on the whole octave.
+//! step out of the window and wait for another pass down the octave.
 
 use crate::sparse_tests::{assert_identical, images};
 use crate::{Sift, SiftParams};
@@ -35,7 +35,7 @@ fn a_window_too_small_slides_and_grows_and_changes_nothing() {
 }
 
 #[test]
-fn refinements_out_of_the_window_are_redone_whole_and_keep_their_place() {
+fn refinements_out_of_the_window_resume_in_another_pass_and_keep_their_place() {
     // A margin of 0 or 1 row: most keypoints read rows the window no longer (or does not yet) hold.
     for margin in [0, 1, 3] {
         check(SiftParams::default(), Some((margin, 24)), &format!("margin {margin}"));
