@@ -506,8 +506,9 @@ mod tests {
         };
         let mut g = vec![vec![0.0f32; w * h]; 4];
         for l in 0..3 {
-            for i in 0..w * h {
-                g[l + 1][i] = g[l][i] + dog(l, i / w, i % w);
+            let (below, above) = g.split_at_mut(l + 1);
+            for (i, (up, &down)) in above[0].iter_mut().zip(&below[l]).enumerate() {
+                *up = down + dog(l, i / w, i % w);
             }
         }
         let p = SiftParams { n_octave_layers: 1, ..SiftParams::default() };

@@ -211,8 +211,7 @@ impl Sift {
                     let held = oct.held();
                     let mut keep = usize::MAX;
                     for (i, job) in &mut waiting {
-                        loop {
-                            let Some(j) = job else { break };
+                        while let Some(j) = *job {
                             let need = j.rows(&p, ow, oh);
                             if need.start < held.start {
                                 break; // the next pass
@@ -221,7 +220,7 @@ impl Sift {
                                 keep = keep.min(need.start);
                                 break;
                             }
-                            match process_candidate(oct, o, Some(*j), &p, ori, desc, &mut angles, &mut out) {
+                            match process_candidate(oct, o, Some(j), &p, ori, desc, &mut angles, &mut out) {
                                 Ok(()) => {
                                     tagged.extend(out.drain(..).map(|f| (*i, f)));
                                     *job = None;
