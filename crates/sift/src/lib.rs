@@ -176,7 +176,7 @@ impl Sift {
             let (mut next, mut angles, mut waiting) = (0, Vec::new(), Vec::new());
             let mut tagged: Vec<(usize, Found)> = Vec::new();
             let mut out = Vec::new();
-            self.octave.build_scan(rows, n_layers, |oct, r0, r1| {
+            self.octave.build_scan(rows, n_layers, &img.data, |oct, r0, r1| {
                 find_candidates(
                     &oct.gauss,
                     oct.y0,
@@ -207,7 +207,7 @@ impl Sift {
                 // Another pass: each waiting job runs while the rows it reads are held; a job wanting rows above
                 // the window waits for the next pass. Every pass moves every job on, and a job takes at most
                 // `max_interp_steps` + 2 moves.
-                self.octave.build_scan(rows, n_layers, |oct, _, _| {
+                self.octave.build_scan(rows, n_layers, &img.data, |oct, _, _| {
                     let held = oct.held();
                     let mut keep = usize::MAX;
                     for (i, job) in &mut waiting {

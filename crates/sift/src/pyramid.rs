@@ -40,6 +40,12 @@ pub struct Octave {
     scratch: BlurScratch,
     /// Scratch of the upscaling (two horizontally doubled rows).
     up_rows: Vec<f32>,
+    /// The input rows `up_rows` holds (slot `y % 2`).
+    up_held: [usize; 2],
+    /// Doubling the input is left to [`Octave::build_scan`], row by row as the first layer needs them: `spare`
+    /// then holds the doubled rows `spare_rows` only. The input's size.
+    lazy_up: Option<(usize, usize)>,
+    spare_rows: std::ops::Range<usize>,
     /// Skip the constant parts of the images (see `mask`); false computes every pixel (same result).
     pub sparse: bool,
     /// This octave uses the masks (`sparse` and its base is mostly constant).
@@ -205,8 +211,14 @@ impl Octave {
     /// [`Octave::build_scan`] makes it row by row), `gauss[0]` is blurred here.
     pub fn init_base(&mut self, data: &[f32], w: usize, h: usize, params: &SiftParams, windowed: bool) {
         let (sigma, init) = (params.sigma, params.init_sigma);
+        // A windowed build doubles the rows as it needs them (unless the edge mask must be taken from the
+        // doubled image itself, below).
+        self.lazy_up = (windowed && params.upscale && (2 * w).max(2 * h) <= 1 << 22).then_some((w, h));
+        (self.spare_rows, self.up_held) = (0..0, [usize::MAX; 2]);
         let (bw, bh, sig_diff) = if params.upscale {
-            upscale2x(data, w, h, &mut self.spare, &mut self.up_rows);
+            if self.lazy_up.is_none() {
+                upscale2x(data, w, h, &mut self.spare, &mut self.up_rows);
+            }
             (2 * w, 2 * h, (sigma * sigma - init * init * 4.0).max(0.01).sqrt())
         } else {
             ensure_len(&mut self.spare, w * h);
@@ -261,6 +273,7 @@ impl Octave {
         if w == 0 || h == 0 {
             return false;
         }
+        self.lazy_up = None;
         if self.next_made {
             // The wavefront halved the layer as it went (a window of it is all that is left).
             std::mem::swap(&mut self.spare, &mut self.next);
@@ -358,8 +371,15 @@ impl Octave {
     /// them when the octave is shorter): the window slides down the octave. `step(octave, r0, r1)` is called
     /// with consecutive row ranges `0..r1` whose rows up to `r1` (inclusive) are final in every layer, and
     /// returns the lowest row it will still read; [`Octave::held`] says which rows it may read now. Also
-    /// makes the next octave's base. Same values as [`Octave::build`], bit for bit.
-    pub fn build_scan(&mut self, window: usize, n_layers: usize, mut step: impl FnMut(&Octave, usize, usize) -> usize) {
+    /// makes the next octave's base. `input` is the image given to [`Octave::init_base`] (the first octave
+    /// doubles its rows here). Same values as [`Octave::build`], bit for bit.
+    pub fn build_scan(
+        &mut self,
+        window: usize,
+        n_layers: usize,
+        input: &[f32],
+        mut step: impl FnMut(&Octave, usize, usize) -> usize,
+    ) {
         const BAND: usize = 16;
         let (w, h) = (self.w, self.h);
         let layers = self.gauss.len();
@@ -412,7 +432,7 @@ impl Octave {
                     }
                 }
                 if i == 0 {
-                    self.base_rows(avail[0], target);
+                    self.base_rows(avail[0], target, input);
                 } else {
                     let (done, rest) = self.gauss.split_at_mut(i);
                     let sp = self.masked.then(|| Sparse { vert: &self.vert[i], out: &self.out[i] });
@@ -447,15 +467,36 @@ impl Octave {
     }
 
     /// Rows `y0 .. y1` of `gauss[0]` (window from `self.y0`), from `spare`.
-    fn base_rows(&mut self, y0: usize, y1: usize) {
-        let (w, o) = (self.w, self.y0);
+    fn base_rows(&mut self, y0: usize, y1: usize, input: &[f32]) {
+        let (w, h, o) = (self.w, self.h, self.y0);
         if self.base_kernel.radius() == 0 {
             self.gauss[0][(y0 - o) * w..(y1 - o) * w].copy_from_slice(&self.spare[y0 * w..y1 * w]);
-        } else {
-            let sp = self.masked.then(|| Sparse { vert: &self.vert[0], out: &self.out[0] });
-            let src = Plane::new(&self.spare[..w * self.h], w, self.h);
-            blur_band(src, &mut self.gauss[0], o, y0, y1, &self.base_kernel, &mut self.scratch, sp);
+            return;
         }
+        let sp = self.masked.then(|| Sparse { vert: &self.vert[0], out: &self.out[0] });
+        let src = match self.lazy_up {
+            None => Plane::new(&self.spare[..w * h], w, h),
+            Some((iw, ih)) => {
+                // The doubled rows the kernel reads (reflected rows at the top are among the first `r`).
+                let r = self.base_kernel.radius();
+                let (lo, hi) = (y0.saturating_sub(r), (y1 + r).min(h));
+                let held = &mut self.spare_rows;
+                if held.start < lo && lo < held.end {
+                    self.spare.copy_within((lo - held.start) * w..(held.end - held.start) * w, 0);
+                    *held = lo..held.end;
+                } else if !(held.start <= lo && lo < held.end) {
+                    *held = lo..lo;
+                }
+                ensure_len(&mut self.spare, (hi - held.start) * w);
+                for dy in held.end..hi {
+                    let out = &mut self.spare[(dy - held.start) * w..(dy - held.start + 1) * w];
+                    upscale_row(input, iw, ih, dy, out, &mut self.up_rows, &mut self.up_held);
+                }
+                held.end = held.end.max(hi);
+                Plane::window(&self.spare, w, h, held.start)
+            }
+        };
+        blur_band(src, &mut self.gauss[0], o, y0, y1, &self.base_kernel, &mut self.scratch, sp);
     }
 
     /// The rows final in every layer, held from the start of the layer buffers at row [`Octave::y0`].
@@ -499,31 +540,44 @@ fn grow(tmp: &mut BitMask, level: &mut BitMask, r: usize, vert: &mut ChunkMask, 
 pub fn upscale2x(src: &[f32], w: usize, h: usize, dst: &mut Vec<f32>, rows: &mut Vec<f32>) {
     let (dw, dh) = (2 * w, 2 * h);
     ensure_len(dst, dw * dh);
+    let mut held = [usize::MAX; 2];
+    for dy in 0..dh {
+        upscale_row(src, w, h, dy, &mut dst[dy * dw..(dy + 1) * dw], rows, &mut held);
+    }
+}
+
+/// Row `dy` of the doubled `w x h` image `src` (see [`upscale2x`]) into `out`. `rows` holds the doubled
+/// source rows `held` says (slot `y % 2`); start with `[usize::MAX; 2]`.
+fn upscale_row(
+    src: &[f32],
+    w: usize,
+    h: usize,
+    dy: usize,
+    out: &mut [f32],
+    rows: &mut Vec<f32>,
+    held: &mut [usize; 2],
+) {
+    let dw = 2 * w;
     if w == 0 || h == 0 {
         return;
     }
     ensure_len(rows, 2 * dw);
-    // Source row y, doubled horizontally, lives in slot y % 2.
-    let mut held = [usize::MAX; 2];
-    for dy in 0..dh {
-        let (sy, fy) = src_coord(dy, h);
-        let last = if fy == 0.0 { sy } else { sy + 1 };
-        for y in sy..=last {
-            if held[y % 2] != y {
-                hdouble(&src[y * w..y * w + w], &mut rows[(y % 2) * dw..(y % 2 + 1) * dw]);
-                held[y % 2] = y;
-            }
+    let (sy, fy) = src_coord(dy, h);
+    let last = if fy == 0.0 { sy } else { sy + 1 };
+    for y in sy..=last {
+        if held[y % 2] != y {
+            hdouble(&src[y * w..y * w + w], &mut rows[(y % 2) * dw..(y % 2 + 1) * dw]);
+            held[y % 2] = y;
         }
-        let out = &mut dst[dy * dw..dy * dw + dw];
-        let r0 = &rows[(sy % 2) * dw..(sy % 2 + 1) * dw];
-        if fy == 0.0 {
-            out.copy_from_slice(r0);
-        } else {
-            let r1 = &rows[((sy + 1) % 2) * dw..((sy + 1) % 2 + 1) * dw];
-            let (b0, b1) = (1.0 - fy, fy);
-            for ((o, &a), &b) in out.iter_mut().zip(r0).zip(r1) {
-                *o = a * b0 + b * b1;
-            }
+    }
+    let r0 = &rows[(sy % 2) * dw..(sy % 2 + 1) * dw];
+    if fy == 0.0 {
+        out.copy_from_slice(r0);
+    } else {
+        let r1 = &rows[((sy + 1) % 2) * dw..((sy + 1) % 2 + 1) * dw];
+        let (b0, b1) = (1.0 - fy, fy);
+        for ((o, &a), &b) in out.iter_mut().zip(r0).zip(r1) {
+            *o = a * b0 + b * b1;
         }
     }
 }
