@@ -28,8 +28,9 @@ pub struct SiftParams {
     pub border: usize,
     /// Maximum sub-pixel interpolation steps before a candidate is dropped (OpenCV `SIFT_MAX_INTERP_STEPS`, 5).
     pub max_interp_steps: usize,
-    /// Run per-keypoint work (refinement, orientation, descriptor) on the rayon pool (default false:
-    /// single-threaded, identical output either way).
+    /// Run the blurs and the per-keypoint work (refinement, orientation, descriptor) on the rayon pool, each
+    /// octave's layers held whole (default false: one thread, the layers through a sliding window of rows, a
+    /// fraction of the memory); identical output either way.
     pub parallel: bool,
 }
 
