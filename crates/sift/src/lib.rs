@@ -132,109 +132,13 @@ impl Sift {
             if o >= 31 {
                 break;
             }
-            let (ow, oh) = (self.octave.w, self.octave.h);
             self.octave.plan(threshold, p.border);
             self.candidates.clear();
-            let n_layers = p.n_octave_layers;
             if p.parallel {
-                self.octave.build(true);
-                let oct = &self.octave;
-                find_candidates(
-                    &oct.gauss,
-                    0,
-                    ow,
-                    oh,
-                    n_layers,
-                    threshold,
-                    p.border,
-                    0..oh,
-                    oct.scan_mask(),
-                    &mut self.dog_rows,
-                    &mut self.candidates,
-                );
-                let per: Vec<Vec<Found>> = self
-                    .candidates
-                    .par_iter()
-                    .map_init(
-                        || (OriScratch::default(), DescScratch::default(), Vec::new()),
-                        |(ori, desc, angles), &cand| {
-                            let mut v = Vec::new();
-                            // A whole octave holds every row: no job waits.
-                            let _ = process_candidate(oct, o, Job::start(cand), &p, ori, desc, angles, &mut v);
-                            v
-                        },
-                    )
-                    .collect();
-                found.extend(per.into_iter().flatten());
-                continue;
+                self.octave_whole(o, threshold, &mut found);
+            } else {
+                self.octave_windowed(&img.data, o, threshold, (margin, rows), &mut found);
             }
-            // The wavefront: candidates are refined and described as soon as the rows around them are final,
-            // so the layers need hold only a window of rows. A refinement that steps to rows the window no longer
-            // (or does not yet) hold waits, and is resumed in another pass down the octave (rare: a step far
-            // across a flat region); keypoints keep their candidate's place in the order.
-            let (cands, ring, ori, desc) = (&mut self.candidates, &mut self.dog_rows, &mut self.ori, &mut self.desc);
-            let (mut next, mut angles, mut waiting) = (0, Vec::new(), Vec::new());
-            let mut tagged: Vec<(usize, Found)> = Vec::new();
-            let mut out = Vec::new();
-            self.octave.build_scan(rows, n_layers, &img.data, |oct, r0, r1| {
-                find_candidates(
-                    &oct.gauss,
-                    oct.y0,
-                    ow,
-                    oh,
-                    n_layers,
-                    threshold,
-                    p.border,
-                    r0..r1,
-                    oct.scan_mask(),
-                    ring,
-                    cands,
-                );
-                let last = r1 >= oh;
-                while let Some(&cand) = cands.get(next) {
-                    if !last && cand.r + margin > r1 {
-                        break;
-                    }
-                    match process_candidate(oct, o, Job::start(cand), &p, ori, desc, &mut angles, &mut out) {
-                        Ok(()) => tagged.extend(out.drain(..).map(|f| (next, f))),
-                        Err(job) => waiting.push((next, Some(job))),
-                    }
-                    next += 1;
-                }
-                cands.get(next).map_or(r1, |c| c.r.min(r1)).saturating_sub(margin)
-            });
-            while !waiting.is_empty() {
-                // Another pass: each waiting job runs while the rows it reads are held; a job wanting rows above
-                // the window waits for the next pass. Every pass moves every job on, and a job takes at most
-                // `max_interp_steps` + 2 moves.
-                self.octave.build_scan(rows, n_layers, &img.data, |oct, _, _| {
-                    let held = oct.held();
-                    let mut keep = usize::MAX;
-                    for (i, job) in &mut waiting {
-                        while let Some(j) = *job {
-                            let need = j.rows(&p, ow, oh);
-                            if need.start < held.start {
-                                break; // the next pass
-                            }
-                            if need.end > held.end {
-                                keep = keep.min(need.start);
-                                break;
-                            }
-                            match process_candidate(oct, o, Some(j), &p, ori, desc, &mut angles, &mut out) {
-                                Ok(()) => {
-                                    tagged.extend(out.drain(..).map(|f| (*i, f)));
-                                    *job = None;
-                                }
-                                Err(moved) => *job = Some(moved),
-                            }
-                        }
-                    }
-                    keep.min(held.end)
-                });
-                waiting.retain(|(_, job)| job.is_some());
-                tagged.sort_by_key(|t| t.0);
-            }
-            found.extend(tagged.into_iter().map(|t| t.1));
         }
         // Back to input-image coordinates (OpenCV: firstOctave = -1 halves positions and sizes).
         if first_octave < 0 {
@@ -265,6 +169,105 @@ impl Sift {
             out.descriptors.extend_from_slice(&found[i].1);
         }
         out
+    }
+    /// The keypoints of octave `o`, its layers built whole (blurs and keypoints on the rayon pool).
+    fn octave_whole(&mut self, o: usize, threshold: f32, found: &mut Vec<Found>) {
+        let p = &self.params;
+        let (ow, oh, n_layers) = (self.octave.w, self.octave.h, p.n_octave_layers);
+        self.octave.build(true);
+        let oct = &self.octave;
+        let (ring, cands) = (&mut self.dog_rows, &mut self.candidates);
+        find_candidates(&oct.gauss, 0, ow, oh, n_layers, threshold, p.border, 0..oh, oct.scan_mask(), ring, cands);
+        let per: Vec<Vec<Found>> = cands
+            .par_iter()
+            .map_init(
+                || (OriScratch::default(), DescScratch::default(), Vec::new()),
+                |(ori, desc, angles), &cand| {
+                    let mut v = Vec::new();
+                    // A whole octave holds every row: no job waits.
+                    let _ = process_candidate(oct, o, Job::start(cand), p, ori, desc, angles, &mut v);
+                    v
+                },
+            )
+            .collect();
+        found.extend(per.into_iter().flatten());
+    }
+
+    /// The keypoints of octave `o` on one thread, its layers built as a wavefront through a window of `rows`
+    /// rows (`input`: the image, whose rows the first octave doubles as it goes).
+    ///
+    /// Candidates are refined and described as soon as the rows `margin` below them are final, so the layers
+    /// need hold only a window of rows. A refinement that steps to rows the window no longer (or does not yet)
+    /// hold waits, and is resumed in another pass down the octave (rare: a step far across a flat region);
+    /// keypoints keep their candidate's place in the order.
+    fn octave_windowed(
+        &mut self,
+        input: &[f32],
+        o: usize,
+        threshold: f32,
+        (margin, rows): (usize, usize),
+        found: &mut Vec<Found>,
+    ) {
+        let p = &self.params;
+        let (ow, oh, n_layers) = (self.octave.w, self.octave.h, p.n_octave_layers);
+        let (cands, ring, ori, desc) = (&mut self.candidates, &mut self.dog_rows, &mut self.ori, &mut self.desc);
+        let (mut next, mut angles, mut waiting) = (0, Vec::new(), Vec::new());
+        let mut tagged: Vec<(usize, Found)> = Vec::new();
+        let mut out = Vec::new();
+        self.octave.build_scan(rows, n_layers, input, |oct, r0, r1| {
+            let mask = oct.scan_mask();
+            find_candidates(&oct.gauss, oct.y0, ow, oh, n_layers, threshold, p.border, r0..r1, mask, ring, cands);
+            let last = r1 >= oh;
+            while let Some(&cand) = cands.get(next) {
+                if !last && cand.r + margin > r1 {
+                    break;
+                }
+                match process_candidate(oct, o, Job::start(cand), p, ori, desc, &mut angles, &mut out) {
+                    Ok(()) => tagged.extend(out.drain(..).map(|f| (next, f))),
+                    Err(job) => waiting.push((next, Some(job))),
+                }
+                next += 1;
+            }
+            cands.get(next).map_or(r1, |c| c.r.min(r1)).saturating_sub(margin)
+        });
+        let resumed = !waiting.is_empty();
+        while !waiting.is_empty() {
+            // Another pass: each waiting job runs while the rows it reads are held; a job wanting rows above the
+            // window waits for the next pass. Every pass moves every job on (the window keeps the rows a job
+            // waits for), and a job takes at most `max_interp_steps` + 2 moves.
+            let mut moved = false;
+            self.octave.build_scan(rows, n_layers, input, |oct, _, _| {
+                let held = oct.held();
+                let mut keep = usize::MAX;
+                for (i, job) in &mut waiting {
+                    while let Some(j) = *job {
+                        let need = j.rows(p, ow, oh);
+                        if need.start < held.start {
+                            break; // the next pass
+                        }
+                        if need.end > held.end {
+                            keep = keep.min(need.start);
+                            break;
+                        }
+                        moved = true;
+                        match process_candidate(oct, o, Some(j), p, ori, desc, &mut angles, &mut out) {
+                            Ok(()) => {
+                                tagged.extend(out.drain(..).map(|f| (*i, f)));
+                                *job = None;
+                            }
+                            Err(left) => *job = Some(left),
+                        }
+                    }
+                }
+                keep.min(held.end)
+            });
+            assert!(moved, "a pass down the octave moves every waiting job on");
+            waiting.retain(|(_, job)| job.is_some());
+        }
+        if resumed {
+            tagged.sort_by_key(|t| t.0);
+        }
+        found.extend(tagged.into_iter().map(|t| t.1));
     }
 }
 
