@@ -381,6 +381,31 @@ fn solve3(mut a: [[f32; 3]; 3], mut b: [f32; 3]) -> Option<[f32; 3]> {
     Some(b)
 }
 
+/// DoG values on the 0..1 scale of an 8-bit image (OpenCV's `img_scale` for float input scaled to 0..255).
+const IMG_SCALE: f32 = 1.0 / 255.0;
+
+/// The DoG's gradient at pixel (`r`, `c`) of layer `l`: x, y and scale (central differences, OpenCV's scale).
+#[inline(always)]
+fn gradient(dog: &DogView<'_>, l: usize, r: isize, c: isize) -> [f32; 3] {
+    let deriv_scale = IMG_SCALE * 0.5;
+    [
+        (dog.at(l, r, c + 1) - dog.at(l, r, c - 1)) * deriv_scale,
+        (dog.at(l, r + 1, c) - dog.at(l, r - 1, c)) * deriv_scale,
+        (dog.at(l + 1, r, c) - dog.at(l - 1, r, c)) * deriv_scale,
+    ]
+}
+
+/// The DoG's spatial second derivatives `(dxx, dyy, dxy)` at pixel (`r`, `c`) of layer `l`.
+#[inline(always)]
+fn hessian_xy(dog: &DogView<'_>, l: usize, r: isize, c: isize) -> (f32, f32, f32) {
+    let v2 = dog.at(l, r, c) * 2.0;
+    let dxx = (dog.at(l, r, c + 1) + dog.at(l, r, c - 1) - v2) * IMG_SCALE;
+    let dyy = (dog.at(l, r + 1, c) + dog.at(l, r - 1, c) - v2) * IMG_SCALE;
+    let dxy = (dog.at(l, r + 1, c + 1) - dog.at(l, r + 1, c - 1) - dog.at(l, r - 1, c + 1) + dog.at(l, r - 1, c - 1))
+        * (IMG_SCALE * 0.25);
+    (dxx, dyy, dxy)
+}
+
 /// Refines a candidate to sub-pixel and sub-scale accuracy (Lowe 2004 §4, OpenCV `adjustLocalExtrema`)
 /// and applies the contrast and edge tests, from `state` on. `Ok(None)` when rejected; `Err` with the state
 /// reached when the next step reads rows the view does not hold.
@@ -393,10 +418,7 @@ pub fn refine(
 ) -> Result<Option<Refined>, RefineState> {
     // Every read is at rows r - 1 ..= r + 1.
     let inside = |r: isize| r > dog.y0 as isize && r + 1 < dog.y1 as isize;
-    let img_scale = 1.0f32 / 255.0;
-    let deriv_scale = img_scale * 0.5;
-    let second_deriv_scale = img_scale;
-    let cross_deriv_scale = img_scale * 0.25;
+    let (second_deriv_scale, cross_deriv_scale) = (IMG_SCALE, IMG_SCALE * 0.25);
     let n_layers = params.n_octave_layers;
     let border = params.border as isize;
     let RefineState { mut r, mut c, mut layer, step, mut offsets } = state;
@@ -408,17 +430,10 @@ pub fn refine(
             }
             let (img, prev, next) = (layer as usize, layer as usize - 1, layer as usize + 1);
             let at = |l: usize, rr: isize, cc: isize| dog.at(l, rr, cc);
-            let d_d = [
-                (at(img, r, c + 1) - at(img, r, c - 1)) * deriv_scale,
-                (at(img, r + 1, c) - at(img, r - 1, c)) * deriv_scale,
-                (at(next, r, c) - at(prev, r, c)) * deriv_scale,
-            ];
+            let d_d = gradient(&dog, img, r, c);
             let v2 = at(img, r, c) * 2.0;
-            let dxx = (at(img, r, c + 1) + at(img, r, c - 1) - v2) * second_deriv_scale;
-            let dyy = (at(img, r + 1, c) + at(img, r - 1, c) - v2) * second_deriv_scale;
+            let (dxx, dyy, dxy) = hessian_xy(&dog, img, r, c);
             let dss = (at(next, r, c) + at(prev, r, c) - v2) * second_deriv_scale;
-            let dxy = (at(img, r + 1, c + 1) - at(img, r + 1, c - 1) - at(img, r - 1, c + 1) + at(img, r - 1, c - 1))
-                * cross_deriv_scale;
             let dxs =
                 (at(next, r, c + 1) - at(next, r, c - 1) - at(prev, r, c + 1) + at(prev, r, c - 1)) * cross_deriv_scale;
             let dys =
@@ -454,23 +469,14 @@ pub fn refine(
         let step = params.max_interp_steps;
         return Err(RefineState { r, c, layer, step, offsets });
     }
-    let (img, prev, next) = (layer as usize, layer as usize - 1, layer as usize + 1);
-    let at = |l: usize, rr: isize, cc: isize| dog.at(l, rr, cc);
-    let d_d = [
-        (at(img, r, c + 1) - at(img, r, c - 1)) * deriv_scale,
-        (at(img, r + 1, c) - at(img, r - 1, c)) * deriv_scale,
-        (at(next, r, c) - at(prev, r, c)) * deriv_scale,
-    ];
+    let img = layer as usize;
+    let d_d = gradient(&dog, img, r, c);
     let t = d_d[0] * xc + d_d[1] * xr + d_d[2] * xi;
-    let contr = at(img, r, c) * img_scale + t * 0.5;
+    let contr = dog.at(img, r, c) * IMG_SCALE + t * 0.5;
     if contr.abs() * (n_layers as f32) < params.contrast_threshold {
         return Ok(None);
     }
-    let v2 = at(img, r, c) * 2.0;
-    let dxx = (at(img, r, c + 1) + at(img, r, c - 1) - v2) * second_deriv_scale;
-    let dyy = (at(img, r + 1, c) + at(img, r - 1, c) - v2) * second_deriv_scale;
-    let dxy = (at(img, r + 1, c + 1) - at(img, r + 1, c - 1) - at(img, r - 1, c + 1) + at(img, r - 1, c - 1))
-        * cross_deriv_scale;
+    let (dxx, dyy, dxy) = hessian_xy(&dog, img, r, c);
     let tr = dxx + dyy;
     let det = dxx * dyy - dxy * dxy;
     let et = params.edge_threshold;
