@@ -118,10 +118,6 @@ impl Sift {
         }
         let threshold = p.pre_threshold();
         let windowed = !p.parallel;
-        let (margin, rows) = self.window.unwrap_or_else(|| {
-            let m = window_margin(&p);
-            (m, window_rows(m))
-        });
         self.octave.prepare(&p);
         self.octave.init_base(&img.data, w, h, &p, windowed);
         let mut found: Vec<Found> = Vec::new();
@@ -137,7 +133,12 @@ impl Sift {
             if p.parallel {
                 self.octave_whole(o, threshold, &mut found);
             } else {
-                self.octave_windowed(&img.data, o, threshold, (margin, rows), &mut found);
+                let (ow, oh) = (self.octave.w, self.octave.h);
+                let window = self.window.unwrap_or_else(|| {
+                    let m = window_margin(&p, ow, oh);
+                    (m, window_rows(m))
+                });
+                self.octave_windowed(&img.data, o, threshold, window, &mut found);
             }
         }
         // Back to input-image coordinates (OpenCV: firstOctave = -1 halves positions and sizes).
@@ -250,7 +251,7 @@ impl Sift {
                             break;
                         }
                         moved = true;
-                        match process_candidate(oct, o, Some(j), p, ori, desc, &mut angles, &mut out) {
+                        match process_candidate(oct, o, j, p, ori, desc, &mut angles, &mut out) {
                             Ok(()) => {
                                 tagged.extend(out.drain(..).map(|f| (*i, f)));
                                 *job = None;
@@ -293,18 +294,11 @@ fn keypoint_order(a: &Keypoint, b: &Keypoint) -> Ordering {
         .then(b.octave.cmp(&a.octave))
 }
 
-/// Rows a windowed octave keeps around a candidate: those its refinement (a few steps of a pixel or so), its
-/// orientation histogram and its descriptor read at the largest scale a keypoint of the octave can have.
-fn window_margin(p: &SiftParams) -> usize {
-    let scl = p.sigma * 2f32.powf((p.n_octave_layers as f32 + 0.5) / p.n_octave_layers as f32);
-    let desc = (descriptor::DESCR_SCL_FCTR * scl * std::f32::consts::SQRT_2 * (descriptor::D as f32 + 1.0) * 0.5)
-        .round_ties_even();
-    let ori = (ORI_RADIUS * scl).round_ties_even();
-    // A large sigma is not worth a window: the layers are held whole.
-    if !desc.is_finite() || desc > 1000.0 {
-        return usize::MAX / 4;
-    }
-    desc.max(ori) as usize + 1 + 8
+/// Rows a windowed `w` x `h` octave keeps around a candidate: those its orientation histogram and descriptor
+/// read at the largest scale a keypoint can have, and a few for its refinement's steps of a pixel or so.
+fn window_margin(p: &SiftParams, w: usize, h: usize) -> usize {
+    let largest = p.sigma * 2f32.powf((p.n_octave_layers as f32 + 0.5) / p.n_octave_layers as f32);
+    describe_reach(largest, w, h) + 8
 }
 
 /// Rows of a layer a windowed octave holds: three times what the wavefront keeps at once (the candidates'
@@ -323,8 +317,8 @@ enum Job {
 }
 
 impl Job {
-    fn start(cand: Candidate) -> Option<Self> {
-        Some(Job::Refine(RefineState::start(cand)))
+    fn start(cand: Candidate) -> Self {
+        Job::Refine(RefineState::start(cand))
     }
 
     /// The rows the job's next move reads.
@@ -332,7 +326,7 @@ impl Job {
         match self {
             Job::Refine(st) => st.rows(),
             Job::Describe(rf) => {
-                let reach = describe_reach(rf, p, w, h);
+                let reach = describe_reach(octave_scale(rf, p), w, h);
                 rf.r.saturating_sub(reach)..(rf.r + reach + 1).min(h)
             }
         }
@@ -344,21 +338,21 @@ fn octave_scale(rf: &Refined, p: &SiftParams) -> f32 {
     p.sigma * 2f32.powf((rf.layer as f32 + rf.xi) / p.n_octave_layers as f32)
 }
 
-/// Rows on each side of a refined keypoint its orientation histogram and descriptor read.
-fn describe_reach(rf: &Refined, p: &SiftParams, w: usize, h: usize) -> usize {
-    let scl = octave_scale(rf, p);
+/// Rows on each side of a keypoint at scale `scl` of a `w` x `h` octave its orientation histogram and
+/// descriptor read.
+fn describe_reach(scl: f32, w: usize, h: usize) -> usize {
     let ori_radius = (ORI_RADIUS * scl).round_ties_even().max(0.0) as usize;
     ori_radius.max(descriptor::radius(scl, w, h)) + 1
 }
 
 /// Refines one candidate, assigns its orientations and computes one descriptor per orientation, from `job`
-/// on (`None`: nothing to do); `Err` with the job left when its next move reads rows the octave does not hold
+/// on; `Err` with the job left when its next move reads rows the octave does not hold
 /// (a windowed octave).
 #[allow(clippy::too_many_arguments)]
 fn process_candidate(
     oct: &Octave,
     o: usize,
-    job: Option<Job>,
+    job: Job,
     p: &SiftParams,
     ori: &mut OriScratch,
     desc: &mut DescScratch,
@@ -368,32 +362,29 @@ fn process_candidate(
     let (w, h) = (oct.w, oct.h);
     let held = oct.held();
     let rf = match job {
-        None => return Ok(()),
-        Some(Job::Describe(rf)) => rf,
-        Some(Job::Refine(st)) => {
-            match refine(DogView { gauss: &oct.gauss, w, y0: held.start, y1: held.end }, w, h, st, p) {
-                Ok(Some(rf)) => rf,
-                Ok(None) => return Ok(()),
-                Err(st) => return Err(Job::Refine(st)),
-            }
-        }
+        Job::Describe(rf) => rf,
+        Job::Refine(st) => match refine(DogView { gauss: &oct.gauss, w, y0: held.start, y1: held.end }, w, h, st, p) {
+            Ok(Some(rf)) => rf,
+            Ok(None) => return Ok(()),
+            Err(st) => return Err(Job::Refine(st)),
+        },
     };
     let need = Job::Describe(rf).rows(p, w, h);
     if need.start < held.start || need.end > held.end {
         return Err(Job::Describe(rf));
     }
-    let n_layers = p.n_octave_layers;
     let octv_scale = (1u32 << o) as f32;
     let base = Keypoint {
         x: (rf.c as f32 + rf.xc) * octv_scale,
         y: (rf.r as f32 + rf.xr) * octv_scale,
-        size: p.sigma * 2f32.powf((rf.layer as f32 + rf.xi) / n_layers as f32) * octv_scale * 2.0,
+        size: octave_scale(&rf, p) * octv_scale * 2.0,
         angle: 0.0,
         response: rf.contr.abs(),
         octave: o as i32
             + ((rf.layer as i32) << 8)
             + ((((f64::from(rf.xi) + 0.5) * 255.0).round_ties_even() as i32) << 16),
     };
+    // OpenCV's `size * 0.5 / 2^o`: `octave_scale` exactly (powers of two), the scale `describe_reach` was given.
     let scl_octv = base.size * 0.5 / octv_scale;
     let gauss = oct.plane(rf.layer);
     let mut hist = [0.0f32; ORI_HIST_BINS];

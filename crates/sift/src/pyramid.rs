@@ -43,8 +43,8 @@ pub struct Octave {
     /// The input rows `up_rows` holds (slot `y % 2`).
     up_held: [usize; 2],
     /// Doubling the input is left to [`Octave::build_scan`], row by row as the first layer needs them: `spare`
-    /// then holds the doubled rows `spare_rows` only. The input's size.
-    lazy_up: Option<(usize, usize)>,
+    /// then holds the doubled rows `spare_rows` only.
+    lazy_up: bool,
     spare_rows: std::ops::Range<usize>,
     /// Skip the constant parts of the images (see `mask`); false computes every pixel (same result).
     pub sparse: bool,
@@ -213,10 +213,10 @@ impl Octave {
         let (sigma, init) = (params.sigma, params.init_sigma);
         // A windowed build doubles the rows as it needs them (unless the edge mask must be taken from the
         // doubled image itself, below).
-        self.lazy_up = (windowed && params.upscale && (2 * w).max(2 * h) <= 1 << 22).then_some((w, h));
+        self.lazy_up = windowed && params.upscale && (2 * w).max(2 * h) <= 1 << 22;
         (self.spare_rows, self.up_held) = (0..0, [usize::MAX; 2]);
         let (bw, bh, sig_diff) = if params.upscale {
-            if self.lazy_up.is_none() {
+            if !self.lazy_up {
                 upscale2x(data, w, h, &mut self.spare, &mut self.up_rows);
             }
             (2 * w, 2 * h, (sigma * sigma - init * init * 4.0).max(0.01).sqrt())
@@ -273,7 +273,7 @@ impl Octave {
         if w == 0 || h == 0 {
             return false;
         }
-        self.lazy_up = None;
+        self.lazy_up = false;
         if self.next_made {
             // The wavefront halved the layer as it went (a window of it is all that is left).
             std::mem::swap(&mut self.spare, &mut self.next);
@@ -474,27 +474,26 @@ impl Octave {
             return;
         }
         let sp = self.masked.then(|| Sparse { vert: &self.vert[0], out: &self.out[0] });
-        let src = match self.lazy_up {
-            None => Plane::new(&self.spare[..w * h], w, h),
-            Some((iw, ih)) => {
-                // The doubled rows the kernel reads (reflected rows at the top are among the first `r`).
-                let r = self.base_kernel.radius();
-                let (lo, hi) = (y0.saturating_sub(r), (y1 + r).min(h));
-                let held = &mut self.spare_rows;
-                if held.start < lo && lo < held.end {
-                    self.spare.copy_within((lo - held.start) * w..(held.end - held.start) * w, 0);
-                    *held = lo..held.end;
-                } else if !(held.start <= lo && lo < held.end) {
-                    *held = lo..lo;
-                }
-                ensure_len(&mut self.spare, (hi - held.start) * w);
-                for dy in held.end..hi {
-                    let out = &mut self.spare[(dy - held.start) * w..(dy - held.start + 1) * w];
-                    upscale_row(input, iw, ih, dy, out, &mut self.up_rows, &mut self.up_held);
-                }
-                held.end = held.end.max(hi);
-                Plane::window(&self.spare, w, h, held.start)
+        let src = if self.lazy_up {
+            // The doubled rows the kernel reads (reflected rows at the top are among the first `r`).
+            let r = self.base_kernel.radius();
+            let (lo, hi) = (y0.saturating_sub(r), (y1 + r).min(h));
+            let held = &mut self.spare_rows;
+            if held.start < lo && lo < held.end {
+                self.spare.copy_within((lo - held.start) * w..(held.end - held.start) * w, 0);
+                *held = lo..held.end;
+            } else if !(held.start <= lo && lo < held.end) {
+                *held = lo..lo;
             }
+            ensure_len(&mut self.spare, (hi - held.start) * w);
+            for dy in held.end..hi {
+                let out = &mut self.spare[(dy - held.start) * w..(dy - held.start + 1) * w];
+                upscale_row(input, w / 2, h / 2, dy, out, &mut self.up_rows, &mut self.up_held);
+            }
+            held.end = held.end.max(hi);
+            Plane::window(&self.spare, w, h, held.start)
+        } else {
+            Plane::new(&self.spare[..w * h], w, h)
         };
         blur_band(src, &mut self.gauss[0], o, y0, y1, &self.base_kernel, &mut self.scratch, sp);
     }
