@@ -88,14 +88,16 @@ pub(crate) fn images() -> Vec<(String, GrayImage)> {
     out
 }
 
+/// Detects on every test image with both detectors (each reused across the images) and asserts the same output.
+pub(crate) fn assert_agree_on_images(a: &mut Sift, b: &mut Sift, name: &str) {
+    for (what, img) in images() {
+        assert_identical(&a.detect_and_compute(&img), &b.detect_and_compute(&img), &format!("{name}, {what}"));
+    }
+}
+
 fn check(params: SiftParams, name: &str) {
     let mut sparse = Sift::with_sparse(params.clone(), true);
-    let mut dense = Sift::with_sparse(params, false);
-    for (what, img) in images() {
-        let a = sparse.detect_and_compute(&img);
-        let b = dense.detect_and_compute(&img);
-        assert_identical(&a, &b, &format!("{name}, {what}"));
-    }
+    assert_agree_on_images(&mut sparse, &mut Sift::with_sparse(params, false), name);
 }
 
 #[test]

@@ -3,7 +3,7 @@
 //! with windows so small they slide every band and must grow, and with margins so small that refinements
 //! step out of the window and wait for another pass down the octave.
 
-use crate::sparse_tests::{assert_identical, images};
+use crate::sparse_tests::{assert_agree_on_images, assert_identical};
 use crate::{GrayImage, Sift, SiftParams};
 use proptest::prelude::*;
 
@@ -13,11 +13,7 @@ fn check(params: SiftParams, window: Option<(usize, usize)>, name: &str) {
     let mut whole = Sift::new(SiftParams { parallel: true, ..params.clone() });
     let mut windowed = Sift::new(params);
     windowed.window = window;
-    for (what, img) in images() {
-        let a = windowed.detect_and_compute(&img);
-        let b = whole.detect_and_compute(&img);
-        assert_identical(&a, &b, &format!("{name}, {what}"));
-    }
+    assert_agree_on_images(&mut windowed, &mut whole, name);
 }
 
 #[test]
