@@ -1,7 +1,8 @@
 //! The correlative merger on the 600×600 pair of the SIFT benchmark (`merge.rs`): the whole `merge` pipeline
 //! with the rotation search on rayon's threads and on one thread, and the global search alone; the default
 //! cascade on a pair the SIFT merger refuses (every stage runs, the correlative one merges), and the correlative
-//! search with every rotation (no orientation prior) on the same pair.
+//! search with every rotation (no orientation prior) on the same pair; and the correlative merge by map size
+//! (generated buildings of 300², 600², 900² and 1200² cells cut at overlap 0.5).
 #![allow(missing_docs, reason = "criterion_group! defines an undocumented public function")]
 
 use criterion::{Criterion, criterion_group, criterion_main};
@@ -51,6 +52,26 @@ fn bench_correlative(c: &mut Criterion) {
     g.bench_function("correlative_every_rotation", |b| {
         b.iter(|| merge(&every_rotation, black_box(&pair.a), black_box(&pair.b), &params))
     });
+    g.finish();
+
+    // Time by map size: square buildings at 5 cm (a 0.5 m margin each side), cut at overlap 0.5.
+    let mut g = c.benchmark_group("correlative_by_size");
+    for side_m in [14.0, 29.0, 44.0, 59.0] {
+        let plan = FloorplanParams { width_m: side_m, height_m: side_m, ..FloorplanParams::default() };
+        let map = generate(3, &plan);
+        let pair = cut_pair(&map, &PairSpec { overlap: 0.5, max_shift_m: 2.0, rotate: true }, 3);
+        let out = merge(&parallel, &pair.a, &pair.b, &params);
+        eprintln!(
+            "correlative {}x{}: accepted {} {:?}, stages (ms): {:?}",
+            map.width(),
+            map.height(),
+            out.report.accepted,
+            out.report.reason,
+            out.report.timings_ms
+        );
+        let name = format!("{}x{}", map.width(), map.height());
+        g.bench_function(name, |b| b.iter(|| merge(&parallel, black_box(&pair.a), black_box(&pair.b), &params)));
+    }
     g.finish();
 }
 

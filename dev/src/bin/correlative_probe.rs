@@ -326,6 +326,9 @@ fn main() {
                 agr.walls,
                 agr.common()
             );
+            if std::env::var("TILES").is_ok() {
+                tiles(&a, &b, &t);
+            }
         }
     }
     let cor = CorrelativeMerger::new(p);
