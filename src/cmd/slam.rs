@@ -68,15 +68,9 @@ pub struct SlamArgs {
     /// flags above): e.g. `--set odometry_calibration=20 --set srr=0.2`.
     #[arg(long = "set", value_name = "NAME=VALUE")]
     pub set: Vec<String>,
-    /// Drift injection for testing: systematic heading error, degrees per metre travelled.
-    #[arg(long, default_value_t = 0.0)]
-    pub drift_heading: f64,
-    /// Drift injection: relative scale error of travelled distance (0.03 = +3 %).
-    #[arg(long, default_value_t = 0.0)]
-    pub drift_scale: f64,
-    /// Drift injection: random noise per odometry step, relative (std dev per metre / per radian).
-    #[arg(long, default_value_t = 0.0)]
-    pub drift_sigma: f64,
+    /// Odometry errors added to the log's (testing).
+    #[command(flatten)]
+    pub drift: DriftArgs,
     /// Hide the progress bar.
     #[arg(long)]
     pub quiet: bool,
@@ -84,6 +78,65 @@ pub struct SlamArgs {
     /// particles, the scan, Neff, the real-time factor, resampling and loop closure, the relations' errors.
     #[command(flatten)]
     pub viz: super::viz::VizArgs,
+}
+
+/// Odometry errors injected into a log's odometry before the SLAM (`mrslam slam`, `mrslam study logs`): to test
+/// the filter, and the merges of its maps, on worse odometry than the robot had.
+#[derive(Args, Debug, Clone, Copy, PartialEq)]
+pub struct DriftArgs {
+    /// Drift injection for testing: systematic heading error, degrees per metre travelled.
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    pub drift_heading: f64,
+    /// Drift injection: relative scale error of travelled distance (0.03 = +3 %).
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    pub drift_scale: f64,
+    /// Drift injection: random noise per odometry step, relative (std dev per metre / per radian).
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    pub drift_sigma: f64,
+}
+
+impl DriftArgs {
+    /// The drift these flags ask for.
+    pub fn drift(&self) -> Drift {
+        Drift {
+            scale: self.drift_scale,
+            heading_per_m: self.drift_heading.to_radians(),
+            sigma_trans: self.drift_sigma,
+            sigma_rot: self.drift_sigma,
+        }
+    }
+
+    /// Refuses values that are not numbers, a negative noise and a distance scale of -100 % or less.
+    pub fn validate(&self) -> Result<()> {
+        let DriftArgs { drift_heading: h, drift_scale: k, drift_sigma: s } = *self;
+        if !(h.is_finite() && k.is_finite() && s.is_finite()) {
+            bail!("--drift-heading {h}, --drift-scale {k}, --drift-sigma {s}: must be numbers");
+        }
+        if s < 0.0 {
+            bail!("--drift-sigma {s}: must not be negative");
+        }
+        if k <= -1.0 {
+            bail!("--drift-scale {k}: must be above -1 (a distance cannot shrink by 100 % or more)");
+        }
+        Ok(())
+    }
+
+    /// No drift asked for.
+    pub fn is_none(&self) -> bool {
+        self.drift() == Drift::none()
+    }
+
+    /// Re-integrates `odometry` with the drift applied (nothing when none is asked), its noise seeded from `seed`.
+    pub fn inject(&self, odometry: &mut [Odometry], seed: u64) {
+        if !self.is_none() {
+            inject_drift(odometry, &self.drift(), seed ^ 0x5eed_d21f_7000_0001);
+        }
+    }
+
+    /// The flags as a study records them.
+    pub fn describe(&self) -> String {
+        format!("heading {} deg/m, scale {}, sigma {}", self.drift_heading, self.drift_scale, self.drift_sigma)
+    }
 }
 
 /// Runs `mrslam slam`.
@@ -100,6 +153,7 @@ pub fn run(args: SlamArgs) -> Result<ExitCode> {
     if !(args.tolerance.is_finite() && args.tolerance >= 0.0) {
         bail!("--tolerance {}: must be a non-negative number of seconds", args.tolerance);
     }
+    args.drift.validate()?;
     let mut params = args.preset.params();
     if let Some(n) = args.particles {
         params.particles = n;
@@ -130,15 +184,7 @@ pub fn run(args: SlamArgs) -> Result<ExitCode> {
         bail!("{}: no laser scans in the log", args.log.display());
     }
     let mut odo: Vec<Odometry> = log.scans.iter().map(|r| r.odometry).collect();
-    let drift = Drift {
-        scale: args.drift_scale,
-        heading_per_m: args.drift_heading.to_radians(),
-        sigma_trans: args.drift_sigma,
-        sigma_rot: args.drift_sigma,
-    };
-    if drift != Drift::none() {
-        inject_drift(&mut odo, &drift, args.seed ^ 0x5eed_d21f_7000_0001);
-    }
+    args.drift.inject(&mut odo, args.seed);
 
     let jumps = odometry_jumps(&odo, &log.scans);
 

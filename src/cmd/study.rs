@@ -167,9 +167,13 @@ pub struct LogsArgs {
     /// (1: the 3x3 neighbourhood, the gate before 2026-12-02; 2 lets the walls of two robots' SLAM runs meet).
     #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u32).range(0..=4))]
     pub wall_tolerance: u32,
-    /// Seed of the SLAM filter (every part) and of the mergers' draws.
+    /// Seed of the SLAM filter (every part), of the injected drift and of the mergers' draws.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
+    /// Odometry errors added to the whole log's before it is split (as `mrslam slam --drift-*`): how merging
+    /// holds up when the robots' odometry is worse.
+    #[command(flatten)]
+    pub drift: super::slam::DriftArgs,
     /// Relation stamps match a scan's stamp within this many seconds.
     #[arg(long, default_value_t = super::eval::DEFAULT_TOLERANCE)]
     pub tolerance: f64,
@@ -451,6 +455,7 @@ fn logs(a: LogsArgs) -> Result<ExitCode> {
     if !(a.max_error_m >= 0.0 && a.max_error_deg >= 0.0) {
         bail!("--max-error-m and --max-error-deg must not be negative");
     }
+    a.drift.validate()?;
     let algorithms = study::parse_algorithms(&a.algorithms.iter().map(|s| s.trim()).collect::<Vec<_>>())?;
     let mut slam = a.preset.params();
     for kv in &a.slam_set {
@@ -501,6 +506,10 @@ fn logs(a: LogsArgs) -> Result<ExitCode> {
         .set("tolerance", a.tolerance)
         .set("max_error_m", a.max_error_m)
         .set("max_error_deg", a.max_error_deg);
+    if !a.drift.is_none() {
+        // Only with drift: a study folder from before the flags existed resumes as it was.
+        params.set("drift", a.drift.describe());
+    }
     create_out(&a.out)?;
     for o in &outputs {
         super::check_not_input(o, &inputs)?;
@@ -523,9 +532,16 @@ fn logs(a: LogsArgs) -> Result<ExitCode> {
         params.write(&a.out)?;
     }
 
-    let log = a.read.read(&a.log)?;
+    let mut log = a.read.read(&a.log)?;
     if log.scans.is_empty() {
         bail!("{}: no laser scans in the log", a.log.display());
+    }
+    if !a.drift.is_none() {
+        let mut odometry: Vec<_> = log.scans.iter().map(|r| r.odometry).collect();
+        a.drift.inject(&mut odometry, a.seed);
+        for (r, o) in log.scans.iter_mut().zip(odometry) {
+            r.odometry = o;
+        }
     }
     let stamps: Vec<f64> = log.scans.iter().map(|r| r.scan.stamp).collect();
     let ranges = logs::split_by_time(&stamps, a.parts).with_context(|| format!("{}", a.log.display()))?;

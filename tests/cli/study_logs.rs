@@ -181,6 +181,34 @@ fn a_log_split_into_two_robots_is_mapped_merged_scored_and_resumed() {
     assert!(text(&o.stderr).contains("`seed`"), "{}", text(&o.stderr));
 }
 
+#[test]
+fn odometry_drift_is_injected_before_the_split_and_recorded() {
+    let f = files();
+    let (plain, drifted) = (f.root.join("plain"), f.root.join("drifted"));
+    let o = study(&f.log, &f.rels, "2", &plain, &[]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
+    let drift = ["--drift-heading", "2", "--drift-scale", "0.05", "--drift-sigma", "0.01"];
+    let o = study(&f.log, &f.rels, "2", &drifted, &drift);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
+    let json = std::fs::read_to_string(drifted.join("study.json")).unwrap();
+    assert!(json.contains("\"drift\"") && json.contains("heading 2 deg/m"), "{json}");
+    assert!(!std::fs::read_to_string(plain.join("study.json")).unwrap().contains("drift"));
+    // The drifted odometry reached the SLAM (its path differs), which still beats it: the parts' true transform
+    // explains the relations across them as well as without drift.
+    let traj = |d: &Path| std::fs::read_to_string(d.join("part-1.trajectory.txt")).unwrap();
+    assert_ne!(traj(&plain), traj(&drifted));
+    let floor = |d: &Path| -> f64 {
+        let (header, rows) = csv(&d.join("results.csv"));
+        let k = header.split(',').position(|c| c == "truth_error_m").unwrap();
+        rows[0].split(',').nth(k).unwrap().parse().unwrap()
+    };
+    assert!(floor(&drifted) < 0.2, "plain {}, drifted {}", floor(&plain), floor(&drifted));
+    // The drift is part of the study: a resume without it is refused.
+    let o = study(&f.log, &f.rels, "2", &drifted, &["--resume"]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(text(&o.stderr).contains("`drift`"), "{}", text(&o.stderr));
+}
+
 fn refused(o: &Output, needles: &[&str]) {
     let e = text(&o.stderr);
     assert_eq!(o.status.code(), Some(1), "stderr: {e}");
@@ -205,6 +233,8 @@ fn bad_input_is_refused_naming_the_file_and_line() {
     refused(&study(&f.log, &broken, "2", &out, &[]), &["broken.relations:3", "`oops`"]);
     refused(&study(&f.log, &f.rels, "2", &out, &["--slam-set", "warp=1"]), &["--slam-set warp=1"]);
     refused(&study(&f.log, &f.rels, "2", &out, &["--algorithms", "magic"]), &["unknown algorithm `magic`"]);
+    refused(&study(&f.log, &f.rels, "2", &out, &["--drift-sigma", "-0.1"]), &["--drift-sigma -0.1", "negative"]);
+    refused(&study(&f.log, &f.rels, "2", &out, &["--drift-scale", "-1"]), &["--drift-scale -1"]);
     // More parts than the log's scans can fill.
     let short = f.root.join("short.clf");
     let log = std::fs::read_to_string(&f.log).unwrap();
