@@ -346,6 +346,14 @@ fn main() {
             let (s, c, at) = mrslam_merge::dev::score_near(&cor, &a, &b, t);
             println!("global score near the truth {s} at {:?} (wall/free/other points {c:?})", xyt(&at));
         }
+        if std::env::var("REVERSE").is_ok() {
+            // a's walls on b's field: the same poses seen from the other map.
+            for (name, t) in [("best", Some(sig.best)), ("truth", truth)] {
+                let Some(t) = t else { continue };
+                let (s, c, _) = mrslam_merge::dev::score_near(&cor, &b, &a, &t.inverse());
+                println!("reverse score at the {name}: {s} (wall/free/other points of a {c:?})");
+            }
+        }
     }
     run(&cor, &a, &b, truth.as_ref());
 }
