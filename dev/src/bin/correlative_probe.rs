@@ -40,6 +40,7 @@ fn set(p: &mut CorrelativeParams, kv: &str) {
         "rivals" => p.rivals = f as usize,
         "fbrivals" => p.fallback_rivals = f as usize,
         "fbalways" => p.fallback_always = f != 0.0,
+        "cross" => p.cross_check = f != 0.0,
         _ => panic!("unknown key {k}"),
     }
 }
