@@ -70,6 +70,10 @@ pub struct MergeArgs {
     /// test off [default: `CorrelativeParams::default().min_margin`, 0.15].
     #[arg(long, value_parser = margin)]
     pub min_margin: Option<f64>,
+    /// The correlative merger's answer is not checked by the same search the other way round (the other map's
+    /// walls on this one's), as before 2026-12-03; the check refuses answers that are ambiguous that way.
+    #[arg(long)]
+    pub one_way: bool,
     /// Map-to-image encoding: `walls` (free and unknown alike) or `paper` (unknown grey).
     #[arg(long, default_value = "walls", value_parser = ["walls", "paper"])]
     pub encoding: String,
@@ -161,6 +165,7 @@ pub fn run(args: MergeArgs) -> Result<ExitCode> {
     params.ransac.seed = args.seed;
     let mut correlative = CorrelativeParams::default();
     correlative.min_margin = args.min_margin.unwrap_or(correlative.min_margin);
+    correlative.cross_check = !args.one_way;
     let merger: Box<dyn Merger> = match args.algorithm {
         Algorithm::Sift => Box::new(SiftMerger::new(params)),
         Algorithm::Rmap => {

@@ -204,6 +204,27 @@ fn correlative_refuses_an_ambiguous_pose_naming_the_rival_unless_the_test_is_off
 }
 
 #[test]
+fn correlative_answers_are_checked_the_other_way_round_unless_one_way() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    cut_plan(d, 21, "0.5");
+    let report = d.join("r.json");
+    let run = |extra: &[&str]| {
+        let (a, b, m) = (d.join("a.yaml"), d.join("b.yaml"), d.join("m.yaml"));
+        let mut args = vec!["merge", p(&a), p(&b), "-o", p(&m), "--algorithm", "correlative", "--report", p(&report)];
+        args.extend_from_slice(extra);
+        let o = mrslam(&args);
+        assert_eq!(o.status.code(), Some(0), "{}{}", text(&o.stdout), text(&o.stderr));
+        let r: serde_json::Value = serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();
+        r
+    };
+    let (checked, one_way) = (run(&[]), run(&["--one-way"]));
+    assert!(checked["timings_ms"]["cross_check"].is_number(), "{checked}");
+    assert!(one_way["timings_ms"].get("cross_check").is_none(), "{one_way}");
+    assert_eq!(checked["transform"], one_way["transform"], "the check accepts or refuses, it does not move the answer");
+}
+
+#[test]
 fn correlative_refuses_maps_that_do_not_mark_their_walls_and_the_cascade_still_merges_them() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
