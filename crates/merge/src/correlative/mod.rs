@@ -154,8 +154,9 @@ pub struct CorrelativeParams {
     /// this gate refused at 0.6 was right (ACES in 4-6 parts: 5 pairs at 53-59 %, 0.03-0.06 m off), and at 0.5
     /// one more: ACES in 2 parts mapped from the scan lines' own odometry (the log without its ODOM lines), 49 %,
     /// 0.21 m and 0.61° off. Correct answers on the logs score 49-97 %, the false ones 60-70 %: wall agreement
-    /// does not tell them apart there. At 0.4, 0.5 and 0.6 the map-level studies and 580 further generated pairs
-    /// at overlap 0-0.1 gave the same answers (benchmarks/runs/2026-12-04-merge-real-unsettled-check.md).
+    /// does not tell them apart there. The map-level studies and 400 further generated pairs at overlap 0 and 0.05
+    /// gave the same answers at 0.4, 0.5 and 0.6, and 180 29 m plan pairs at 0-0.1 at 0.4 and 0.5
+    /// (benchmarks/runs/2026-12-04-merge-real-unsettled-check.md).
     pub min_wall_agreement: f64,
     /// Lowest acceptance index (Carpin's, [`crate::verify::Agreement::acceptance_index`]) of a pose before
     /// it is handed to verification.
