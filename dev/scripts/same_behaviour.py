@@ -7,7 +7,7 @@
 Groups: `scenarios` (the four shipped scenarios, with their .rrd), `slam` (ACES, FR079 and Intel at seed 0:
 map, trajectory, summary), `studies` (`study logs` ACES in 2 parts, a small map-level `study overlap` with
 every algorithm). `compare` checks maps and trajectories byte for byte, JSON and CSV files with every wall-time
-field removed, and recordings with `rrd_diff` (the dev crate's binary) when given; it prints each difference and
+field removed (studies' plots, which show times, are skipped), and recordings with `rrd_diff` (the dev crate's binary) when given; it prints each difference and
 exits 1 when there is one.
 """
 
@@ -68,10 +68,16 @@ def record(args):
 TIME_WORDS = ("time", "_ms", "seconds", "wall", "elapsed", "duration_s", "real_time", "speed", "peak_memory")
 
 
+def is_time(name):
+    """Whether a JSON key or CSV column holds a wall time or a memory figure (differs between two runs)."""
+    name = name.lower()
+    return any(w in name for w in TIME_WORDS) or name.endswith("_s")
+
+
 def strip_times(v):
     """The JSON value with every field whose name speaks of wall time or memory removed."""
     if isinstance(v, dict):
-        return {k: strip_times(x) for k, x in v.items() if not any(w in k.lower() for w in TIME_WORDS)}
+        return {k: strip_times(x) for k, x in v.items() if not is_time(k)}
     if isinstance(v, list):
         return [strip_times(x) for x in v]
     return v
@@ -81,7 +87,7 @@ def csv_rows(path):
     rows = list(csv.reader(io.StringIO(path.read_text())))
     if not rows:
         return rows
-    keep = [i for i, h in enumerate(rows[0]) if not any(w in h.lower() for w in TIME_WORDS)]
+    keep = [i for i, h in enumerate(rows[0]) if not is_time(h)]
     return [[r[i] for i in keep if i < len(r)] for r in rows]
 
 
@@ -101,6 +107,8 @@ def compare(args):
         elif rel.suffix == ".csv":
             if csv_rows(a) != csv_rows(b):
                 problems.append(f"{rel}: CSV differs (wall-time columns aside)")
+        elif rel.name == "plot.png":
+            continue  # a study's plot shows merge times; its numbers are in the CSV files compared
         elif rel.suffix == ".rrd":
             if args.rrd_diff:
                 r = subprocess.run([args.rrd_diff, a, b], capture_output=True, text=True)
