@@ -12,7 +12,7 @@
 //! go into each particle's copy-on-write `tile_map` → a new `particle` trajectory node.
 //! The output map ([`Rbpf::map`]) is rebuilt by `map_build` from the best particle's trajectory; with
 //! `loop_closure` on, [`map_log`] first smooths that trajectory ([`Rbpf::close_loops`]: `loop_closure` finds
-//! loop edges, `pose_graph` optimises).
+//! loop edges, `mrslam_matching::pose_graph` optimises).
 //!
 //! Modules are private: the items below are the API; [`synthetic`] (test data) is a public namespace and
 //! [`dev`] holds internals public only for the development probes (`dev/` in the repository).
@@ -47,7 +47,6 @@ mod map_build;
 mod motion;
 mod params;
 mod particle;
-mod pose_graph;
 mod rbpf;
 mod resample;
 mod scan_matcher;

@@ -17,11 +17,12 @@
 
 use crate::params::SlamParams;
 use crate::particle::TrajectoryNode;
-use crate::pose_graph::{Edge, optimize};
 use crate::scan_matcher::{Beam, PreparedScan, ScanMatcher, Scratch};
 use crate::tile_map::TileMap;
 use mrslam_core::Xyt;
 use mrslam_core::pose::relative;
+use mrslam_matching::Information;
+use mrslam_matching::pose_graph::{Edge, optimize};
 use rayon::prelude::*;
 
 /// What loop closure did.
@@ -90,14 +91,14 @@ pub fn close_loops(nodes: &[&TrajectoryNode], laser: Xyt, params: &SlamParams) -
     if loops.is_empty() {
         return (poses, report);
     }
-    let chain_info = [
+    let chain_info = Information([
         1.0 / (params.loop_chain_sigma * params.loop_chain_sigma),
         0.0,
         0.0,
         1.0 / (params.loop_chain_sigma * params.loop_chain_sigma),
         0.0,
         1.0 / (params.loop_chain_heading_sigma * params.loop_chain_heading_sigma),
-    ];
+    ]);
     let mut edges: Vec<Edge> = (1..nodes.len())
         .map(|k| Edge {
             from: k - 1,
@@ -187,10 +188,10 @@ fn match_loop(
 /// A loop edge's information from the scan's information `h` about the robot's pose (map frame): rotated into
 /// the robot's frame at heading `theta`, its covariance widened by `loop_sigma` and `loop_heading_sigma` (the
 /// matcher's information counts every beam as independent, which they are not).
-fn loop_information(h: &[f64; 6], theta: f64, params: &SlamParams) -> [f64; 6] {
+fn loop_information(h: &Information, theta: f64, params: &SlamParams) -> Information {
     let (s, c) = theta.sin_cos();
     // Rᵀ H R for the translation block, Rᵀ h_tθ for the coupling.
-    let m = nalgebra::Matrix3::new(h[0], h[1], h[2], h[1], h[3], h[4], h[2], h[4], h[5]);
+    let m = h.matrix();
     let r = nalgebra::Matrix3::new(c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0);
     let local = r.transpose() * m * r;
     let eps = 1e-9 * (local[(0, 0)] + local[(1, 1)] + local[(2, 2)]).max(1e-12);
@@ -201,7 +202,7 @@ fn loop_information(h: &[f64; 6], theta: f64, params: &SlamParams) -> [f64; 6] {
         params.loop_heading_sigma * params.loop_heading_sigma,
     ));
     let info = (cov + floor).try_inverse().unwrap_or(nalgebra::Matrix3::zeros());
-    [info[(0, 0)], info[(0, 1)], info[(0, 2)], info[(1, 1)], info[(1, 2)], info[(2, 2)]]
+    Information::from_matrix(&info)
 }
 
 #[cfg(test)]

@@ -8,7 +8,7 @@ use crate::motion::MotionModel;
 use crate::params::SlamParams;
 use crate::particle::{Particle, TrajectoryNode, ancestry};
 use crate::resample::{normalize, systematic};
-use crate::scan_matcher::{MatchResult, MotionPrior, PreparedScan, ScanMatcher, Scratch};
+use crate::scan_matcher::{MatchInformation, MatchResult, MotionPrior, PreparedScan, ScanMatcher, Scratch};
 use crate::scan_odometry::ScanOdometry;
 use mrslam_core::{LaserScan, OccupancyGrid, Odometry, Pose2};
 use mrslam_core::{Xyt, pose::relative};
@@ -175,7 +175,7 @@ impl Rbpf {
             return Err(SlamError::BadLaserOffset);
         }
         let matcher = ScanMatcher::from_params(&params, laser);
-        let motion = MotionModel { srr: params.srr, srt: params.srt, str: params.str, stt: params.stt };
+        let motion = MotionModel { srr: params.srr, srt: params.srt, trans_from_rot: params.str, stt: params.stt };
         let n = params.particles;
         let scan_odometry = params.scan_odometry.then(|| ScanOdometry::new(&params, laser));
         Ok(Rbpf {
@@ -364,7 +364,7 @@ impl Rbpf {
                     m
                 })
                 .collect();
-            let information: Vec<Option<([f64; 6], [f64; 6])>> =
+            let information: Vec<Option<MatchInformation>> =
                 if calibrating { results.iter().map(|m| m.information).collect() } else { Vec::new() };
             for (part, m) in self.particles.iter_mut().zip(results) {
                 if m.accepted {
@@ -470,10 +470,12 @@ impl Rbpf {
     /// `starts` are the particles' motion-model samples, `information` the matcher's scan and prior
     /// information at each match. Runs once the update's weights are known, before resampling and mapping
     /// (the particles' trajectory nodes still end at the previous update).
-    fn calibrate(&mut self, starts: &[Xyt], information: &[Option<([f64; 6], [f64; 6])>]) {
+    fn calibrate(&mut self, starts: &[Xyt], information: &[Option<MatchInformation>]) {
         let matches = self.particles.iter().zip(starts).zip(information).zip(&self.weights).filter_map(
             |(((part, start), info), &weight)| {
-                let (Some((scan, prior)), Some(node)) = (info, part.node.as_ref()) else { return None };
+                let (Some(MatchInformation { scan, prior }), Some(node)) = (info, part.node.as_ref()) else {
+                    return None;
+                };
                 Some(CalibrationMatch {
                     matched: part.pose,
                     start: *start,

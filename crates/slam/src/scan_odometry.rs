@@ -85,7 +85,7 @@ impl ScanOdometry {
             submaps: [(TileMap::new(params.delta), 0), (TileMap::new(params.delta), 0)],
             last_raw: None,
             pose: Xyt { x: 0.0, y: 0.0, theta: 0.0 },
-            noise: MotionModel { srr: params.srr, srt: params.srt, str: params.str, stt: params.stt },
+            noise: MotionModel { srr: params.srr, srt: params.srt, trans_from_rot: params.str, stt: params.stt },
             scratch: Scratch::default(),
             inserted: 0,
             matched: 0,

@@ -27,6 +27,7 @@ use crate::field::Field;
 use crate::params::SlamParams;
 use crate::tile_map::TileMap;
 use mrslam_core::{LaserScan, Xyt};
+use mrslam_matching::Information;
 
 /// GMapping's `nullLikelihood`: a beam that matches nothing costs `-0.5/lsigma`.
 const NULL_LIKELIHOOD: f64 = -0.5;
@@ -195,20 +196,26 @@ pub struct MotionPrior {
 }
 
 impl MotionPrior {
-    /// The information matrix (upper triangle 00 01 02 11 12 22) in the map frame for a robot at heading
-    /// `t`, scaled by `weight`.
-    fn information(&self, t: f64, weight: f64) -> [f64; 6] {
+    /// The information matrix in the map frame for a robot at heading `t`, scaled by `weight`.
+    fn information(&self, t: f64, weight: f64) -> Information {
         let (s, c) = t.sin_cos();
         let (ix, iy) = (weight / (self.sx * self.sx), weight / (self.sy * self.sy));
-        [c * c * ix + s * s * iy, c * s * (ix - iy), 0.0, s * s * ix + c * c * iy, 0.0, weight / (self.st * self.st)]
+        Information([
+            c * c * ix + s * s * iy,
+            c * s * (ix - iy),
+            0.0,
+            s * s * ix + c * c * iy,
+            0.0,
+            weight / (self.st * self.st),
+        ])
     }
 }
 
-/// A Gaussian prior on the pose: information matrix (map frame, upper triangle 00 01 02 11 12 22) and centre.
+/// A Gaussian prior on the pose: information matrix (map frame) and centre.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PosePrior {
     /// Information matrix.
-    pub info: [f64; 6],
+    pub info: Information,
     /// Centre (the prior's mean).
     pub centre: Xyt,
 }
@@ -255,9 +262,17 @@ pub struct MatchResult {
     /// Beams of the likelihood that found a surface at `pose`.
     pub matched: usize,
     /// `field` matcher with [`ScanMatcher::information`] on: the scan's information about the pose at `pose`
-    /// ([`ScanMatcher::scan_information`]) and the motion prior's (zero without one), map frame, upper
-    /// triangles 00 01 02 11 12 22.
-    pub information: Option<([f64; 6], [f64; 6])>,
+    /// ([`ScanMatcher::scan_information`]) and the motion prior's (zero without one), map frame.
+    pub information: Option<MatchInformation>,
+}
+
+/// The information about a matched pose (map frame): the scan's and the motion prior's.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MatchInformation {
+    /// The scan's ([`ScanMatcher::scan_information`]).
+    pub scan: Information,
+    /// The motion prior's (zero without one).
+    pub prior: Information,
 }
 
 /// Result of evaluating a pose: score, log-likelihood and the number of beams that matched.
@@ -373,8 +388,9 @@ impl ScanMatcher {
                 } else {
                     self.field_eval(f, &pose, weigh)
                 };
-                let information = self.information.then(|| {
-                    (self.scan_information(f, &pose, &scan.matched), prior.as_ref().map_or([0.0; 6], |p| p.info))
+                let information = self.information.then(|| MatchInformation {
+                    scan: self.scan_information(f, &pose, &scan.matched),
+                    prior: prior.as_ref().map_or(Information::ZERO, |p| p.info),
                 });
                 MatchResult { pose, score, likelihood: e.likelihood, accepted, matched: e.matched, information }
             }
