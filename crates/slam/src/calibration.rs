@@ -1,4 +1,4 @@
-//! Online odometry calibration ([`crate::SlamParams::odometry_calibration`]; not GMapping).
+//! Online odometry calibration ([`crate::FilterParams::odometry_calibration`]; not GMapping).
 //!
 //! Model: a raw odometry increment (dx, dy, dθ) is corrected to ((1+a)·dx, (1+a)·dy, dθ + b·dx): a distance
 //! scale error a (wheel radii, slip) and a heading drift b per metre driven forward (unequal wheel radii).

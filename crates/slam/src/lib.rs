@@ -56,9 +56,13 @@ mod tile_map;
 
 pub use error::SlamError;
 pub use every_scan::{LogRun, LogRunError, map_log, poses_at_every_scan};
-pub use loop_closure::LoopClosureReport;
-pub use params::{MatcherKind, Preset, SlamParams};
+pub use loop_closure::{LoopClosureParams, LoopClosureReport};
+pub use map_build::MapParams;
+pub use motion::MotionModel;
+pub use params::{FLAT_NAMES, FilterParams, ParamError, Preset, SlamParams};
 pub use rbpf::{Counters, MemoryStats, Rbpf, SkipReason, UpdateOutcome, UpdateStats};
+pub use scan_matcher::{MatcherKind, MatcherParams};
+pub use scan_odometry::ScanOdometryParams;
 
 /// Internals public only for the development probes (`dev/src/bin/matcher_lab.rs`, `matcher_check.rs`): the
 /// scan matcher on a hand-built tile map. Not part of the crate's API; the filter ([`Rbpf`]) is.

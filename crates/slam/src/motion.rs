@@ -5,18 +5,26 @@ use mrslam_core::{Pose2, pose, pose::normalize_angle};
 use mrslam_core::{Xyt, pose::relative};
 use rand::Rng;
 use rand_distr::StandardNormal;
+use serde::{Deserialize, Serialize};
 
-/// GMapping's odometry noise parameters (see [`crate::SlamParams`]).
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// GMapping's odometry noise parameters, named as GMapping's except `str` (`trans_from_rot`); defaults GMapping's.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct MotionModel {
-    /// Translation error from translation.
+    /// `srr`: odometry translation error from translation (GMapping 0.1).
     pub srr: f64,
-    /// Rotation error from translation.
+    /// `srt`: odometry rotation error from translation, rad/m (GMapping 0.2).
     pub srt: f64,
-    /// Translation error from rotation (GMapping's `str`).
+    /// GMapping's `str`: odometry translation error from rotation, m/rad (GMapping 0.1).
     pub trans_from_rot: f64,
-    /// Rotation error from rotation.
+    /// `stt`: odometry rotation error from rotation (GMapping 0.2).
     pub stt: f64,
+}
+
+impl Default for MotionModel {
+    fn default() -> Self {
+        MotionModel { srr: 0.1, srt: 0.2, trans_from_rot: 0.1, stt: 0.2 }
+    }
 }
 
 /// A zero-mean Gaussian draw of standard deviation `sigma` (0 when sigma is 0, as GMapping's).

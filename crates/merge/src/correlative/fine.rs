@@ -17,7 +17,7 @@ use std::collections::BTreeMap;
 use std::time::Instant;
 
 /// What the fine stage scores on, built once per pair: b's wall points at its own resolution (thinned to
-/// [`CorrelativeParams::max_fine_points`] in the scan) and the score field of a at a's resolution.
+/// [`crate::FineParams::max_points`] in the scan) and the score field of a at a's resolution.
 pub(super) struct FineField {
     /// Every wall point of b (b's frame), for wall ICP.
     pub(super) points: Vec<Point2<f64>>,
@@ -31,9 +31,9 @@ impl FineField {
     /// `cells_a`: a's cells as [`dense_free_cells`] gives them.
     pub(super) fn build(a: &OccupancyGrid, cells_a: &BlockStates, b: &OccupancyGrid, p: &CorrelativeParams) -> Self {
         let points = wall_points(b);
-        let scan = WallScan::of_points(&points, p.max_fine_points);
-        let penalty = (p.fine_free_penalty.max(0.0) * f64::from(HIT)).round() as i16;
-        let field = ScoreField::build(cells_a, p.fine_sigma_cells, penalty);
+        let scan = WallScan::of_points(&points, p.fine.max_points);
+        let penalty = (p.fine.free_penalty.max(0.0) * f64::from(HIT)).round() as i16;
+        let field = ScoreField::build(cells_a, p.fine.sigma_cells, penalty);
         FineField { points, scan, field: WindowField::new(&field, fine_window_cells(a, p) as usize) }
     }
 }
@@ -49,7 +49,7 @@ pub(super) struct FineCache {
 
 /// Offsets the fine windows search either side of a global answer, cells of a: a search cell and one more.
 pub(super) fn fine_window_cells(a: &OccupancyGrid, p: &CorrelativeParams) -> i32 {
-    ((p.search_resolution / a.resolution()).round() as i32).max(1) + 1
+    ((p.search.resolution / a.resolution()).round() as i32).max(1) + 1
 }
 
 /// The global search's answers refined on the fine field, strongest first, and the significance of the first.
@@ -84,8 +84,8 @@ impl CorrelativeMerger {
         let FineField { points: fine_points, scan, field: fine } = fine_field;
         let window = LocalWindow {
             cells: fine_window_cells(a, p),
-            angles: p.fine_angles,
-            angle_step: searches.iter().map(|f| f.step).fold(f64::INFINITY, f64::min) / p.fine_angles.max(1) as f64,
+            angles: p.fine.angles,
+            angle_step: searches.iter().map(|f| f.step).fold(f64::INFINITY, f64::min) / p.fine.angles.max(1) as f64,
         };
         if cache.window != Some(window) {
             *cache = FineCache { window: Some(window), ..FineCache::default() };
@@ -121,7 +121,7 @@ impl CorrelativeMerger {
             |q: &ScanPose, k: &ScanPose| (q.tx - k.tx).hypot(q.ty - k.ty) + scan.radius * angle_gap(q.theta, k.theta);
         let mut distinct: Vec<(usize, ScanPose, i64)> = Vec::new();
         for r in refined {
-            if distinct.iter().all(|k| apart(&r.1, &k.1) > p.distinct_m) {
+            if distinct.iter().all(|k| apart(&r.1, &k.1) > p.search.distinct_m) {
                 distinct.push(r);
             }
         }
@@ -131,7 +131,8 @@ impl CorrelativeMerger {
         let icp = RefineParams::default();
         let window0 = LocalWindow { cells: 0, angles: 0, angle_step: 0.0 };
         let transform = |q: &ScanPose| to_transform(a, &scan.centroid, q);
-        let top: Vec<(usize, ScanPose)> = distinct.iter().take(p.polished.max(1)).map(|&(i, q, _)| (i, q)).collect();
+        let top: Vec<(usize, ScanPose)> =
+            distinct.iter().take(p.fine.polished.max(1)).map(|&(i, q, _)| (i, q)).collect();
         let polish = |buf: &mut LocalScratch, &(i, q): &(usize, ScanPose)| {
             let t = refine(a, fine_points, &transform(&q), &icp);
             let start = to_scan_pose(a, &scan.centroid, &t);
@@ -153,7 +154,7 @@ impl CorrelativeMerger {
         // The significance test: the best polished answer against every one clearly apart from it.
         let moved = |t: &Pose2, u: &Pose2| max_displacement(scan, t, u);
         let (best, best_score) = (polished[0].1, polished[0].2);
-        let rival = polished[1..].iter().find(|r| moved(&r.1, &best) > p.rival_distinct_m);
+        let rival = polished[1..].iter().find(|r| moved(&r.1, &best) > p.answer.rival_distinct_m);
         let significance =
             Significance { best, best_score, rival: rival.map(|r| r.1), rival_score: rival.map_or(0, |r| r.2) };
         *timings.entry("fine".into()).or_insert(0.0) += ms(t);
@@ -161,7 +162,7 @@ impl CorrelativeMerger {
             refined: polished.iter().map(|(_, t, s)| (*t, *s)).collect(),
             significance,
             scan_points: scan.points.iter().map(|v| scan.centroid + v).collect(),
-            min_overlap_m2: p.min_overlap_m2,
+            min_overlap_m2: p.answer.min_overlap_m2,
             best_from_first,
         }
     }

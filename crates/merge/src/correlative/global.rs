@@ -30,8 +30,8 @@ pub(super) struct Global {
 pub(super) struct Found {
     /// The best distinct poses (`T_a_b`), strongest first.
     pub(super) poses: Vec<Pose2>,
-    /// The best distinct answers more than [`CorrelativeParams::rival_distinct_m`] from the first, at most
-    /// [`CorrelativeParams::rivals`], strongest first (none scored below the search's pruning floor).
+    /// The best distinct answers more than [`crate::AnswerParams::rival_distinct_m`] from the first, at most
+    /// [`crate::SearchParams::rivals`], strongest first (none scored below the search's pruning floor).
     pub(super) rivals: Vec<Pose2>,
     /// Angular step of the search, radians.
     pub(super) step: f64,
@@ -44,7 +44,7 @@ pub(super) struct Pooled {
     pub(super) cell: f64,
     /// a's states on search cells.
     pub(super) blocks: BlockStates,
-    /// b's wall blocks, thinned to [`CorrelativeParams::max_points`].
+    /// b's wall blocks, thinned to [`crate::SearchParams::max_points`].
     pub(super) scan: WallScan,
 }
 
@@ -67,12 +67,12 @@ impl Pooled {
     }
 }
 
-/// a's cell states with its free cells kept only where at least [`CorrelativeParams::dense_free_share`] of the
+/// a's cell states with its free cells kept only where at least [`crate::SearchParams::dense_free_share`] of the
 /// search cell's extent (made odd) around them is free: what both the global search and the fine field score.
 pub(super) fn dense_free_cells(a: &OccupancyGrid, p: &CorrelativeParams) -> BlockStates {
-    let fa = ((p.search_resolution / a.resolution()).round() as usize).max(1);
+    let fa = ((p.search.resolution / a.resolution()).round() as usize).max(1);
     let mut cells = BlockStates::cells(a);
-    cells.keep_dense_free(fa | 1, p.dense_free_share);
+    cells.keep_dense_free(fa | 1, p.search.dense_free_share);
     cells
 }
 
@@ -89,28 +89,28 @@ impl CorrelativeMerger {
         let p = &self.params;
         let Pooled { cell, blocks, scan } = pooled;
         let cell = *cell;
-        if scan.points.len() < p.min_points {
+        if scan.points.len() < p.search.min_points {
             return Err(fail(
-                format!("too few walls in map b: {} blocks (need {})", scan.points.len(), p.min_points),
+                format!("too few walls in map b: {} blocks (need {})", scan.points.len(), p.search.min_points),
                 timings.clone(),
             ));
         }
         let t = Instant::now();
-        let penalty = (p.free_penalty.max(0.0) * f64::from(HIT)).round() as i16;
-        let field = ScoreField::build(blocks, p.sigma_cells, penalty);
+        let penalty = (p.search.free_penalty.max(0.0) * f64::from(HIT)).round() as i16;
+        let field = ScoreField::build(blocks, p.search.sigma_cells, penalty);
         if !field.values.contains(&HIT) {
             return Err(fail("map a has no walls".into(), timings.clone()));
         }
-        let pyramid = Pyramid::build(&field, p.depth);
+        let pyramid = Pyramid::build(&field, p.search.depth);
         timings.insert("field".into(), ms(t));
         let t = Instant::now();
-        let step = (p.angle_step_scale * cell / scan.radius.max(cell)).min(PI / 2.0);
+        let step = (p.search.angle_step_scale * cell / scan.radius.max(cell)).min(PI / 2.0);
         let n_rot = (TAU / step).ceil() as usize;
         let step = TAU / n_rot as f64;
-        let tolerance = p.rotation_tolerance_deg.to_radians().max(step);
+        let tolerance = p.search.rotation_tolerance_deg.to_radians().max(step);
         let searched = |j: usize| peaks.is_empty() || orientation::near_a_peak(j as f64 * step, peaks, tolerance);
-        let min_floor = (p.min_score * f64::from(HIT) * scan.points.len() as f64).ceil() as i64;
-        let separation = ((p.distinct_m / cell).ceil() as i32).max(1);
+        let min_floor = (p.search.min_score * f64::from(HIT) * scan.points.len() as f64).ceil() as i64;
+        let separation = ((p.search.distinct_m / cell).ceil() as i32).max(1);
         let one = |scratch: &mut (Vec<(i32, i32)>, Vec<Candidate>), j: usize, floor: i64| -> Vec<Global> {
             let (points, roots) = scratch;
             scan.discretize(j as f64 * step, cell, points);
@@ -119,7 +119,7 @@ impl CorrelativeMerger {
                 (x0, x1, y0, y1) = (x0.min(x), x1.max(x), y0.min(y), y1.max(y));
             }
             let window = Window { x0: -x1, x1: field.width as i32 - 1 - x0, y0: -y1, y1: field.height as i32 - 1 - y0 };
-            let mut best = Best::new(p.per_rotation, separation, floor);
+            let mut best = Best::new(p.search.per_rotation, separation, floor);
             branch_and_bound(&pyramid, points, window, &mut best, roots);
             best.found.iter().map(|&candidate| Global { rotation: j, candidate }).collect()
         };
@@ -133,7 +133,7 @@ impl CorrelativeMerger {
             let found = map_with_scratch(p.parallel, &js, |s, &j| one(s, j, floor));
             all.extend(found.into_iter().flatten());
             let top = all.iter().map(|g| g.candidate.score).max().unwrap_or(i64::MIN);
-            floor = floor.max((p.keep_ratio * top as f64).ceil() as i64);
+            floor = floor.max((p.search.keep_ratio * top as f64).ceil() as i64);
         }
         all.retain(|g| g.candidate.score >= floor);
         all.sort_by(|x, y| {
@@ -155,7 +155,7 @@ impl CorrelativeMerger {
         let mut kept: Vec<(ScanPose, i64)> = Vec::new();
         for g in &all {
             let q = as_pose(g);
-            if kept.iter().all(|(k, _)| apart(&q, k) > p.distinct_m) {
+            if kept.iter().all(|(k, _)| apart(&q, k) > p.search.distinct_m) {
                 kept.push((q, g.candidate.score));
                 if kept.len() >= keep.max(1) {
                     break;
@@ -164,7 +164,7 @@ impl CorrelativeMerger {
         }
         if kept.is_empty() {
             return Err(fail(
-                format!("no pose scores above {:.0}% of a perfect fit", 100.0 * p.min_score),
+                format!("no pose scores above {:.0}% of a perfect fit", 100.0 * p.search.min_score),
                 timings.clone(),
             ));
         }
@@ -172,10 +172,12 @@ impl CorrelativeMerger {
         let winner = kept[0].0;
         let mut rivals: Vec<ScanPose> = Vec::new();
         for q in all.iter().map(as_pose) {
-            if rivals.len() >= p.rivals {
+            if rivals.len() >= p.search.rivals {
                 break;
             }
-            if apart(&q, &winner) > p.rival_distinct_m && rivals.iter().all(|k| apart(&q, k) > p.distinct_m) {
+            if apart(&q, &winner) > p.answer.rival_distinct_m
+                && rivals.iter().all(|k| apart(&q, k) > p.search.distinct_m)
+            {
                 rivals.push(q);
             }
         }
@@ -187,8 +189,8 @@ impl CorrelativeMerger {
         })
     }
 
-    /// The global answers at [`CorrelativeParams::search_resolution`], strongest first, and the angular step
-    /// they were found at; screened first at [`CorrelativeParams::screen_resolution`] when that is coarser.
+    /// The global answers at [`crate::SearchParams::resolution`], strongest first, and the angular step
+    /// they were found at; screened first at [`crate::SearchParams::screen_resolution`] when that is coarser.
     pub(super) fn search(
         &self,
         a: &OccupancyGrid,
@@ -199,21 +201,21 @@ impl CorrelativeMerger {
         timings: &mut BTreeMap<String, f64>,
     ) -> Result<Found, Box<NoAlignment>> {
         let p = &self.params;
-        if p.screen_resolution < 1.5 * p.search_resolution {
-            return self.global(a, pooled, p.hypotheses, peaks, timings);
+        if p.search.screen_resolution < 1.5 * p.search.resolution {
+            return self.global(a, pooled, p.answer.hypotheses, peaks, timings);
         }
         let t = Instant::now();
-        let screen = Pooled::build(a, cells_a, b, p.screen_resolution, p.max_points);
+        let screen = Pooled::build(a, cells_a, b, p.search.screen_resolution, p.search.max_points);
         timings.insert("pool_screen".into(), ms(t));
-        let coarse = self.global(a, &screen, p.screen_candidates, peaks, timings)?;
+        let coarse = self.global(a, &screen, p.search.screen_candidates, peaks, timings)?;
         // Each screened answer searched again around itself at the search resolution.
         let t = Instant::now();
         let Pooled { cell, blocks, scan } = pooled;
         let cell = *cell;
-        let penalty = (p.free_penalty.max(0.0) * f64::from(HIT)).round() as i16;
-        let step = (p.angle_step_scale * cell / scan.radius.max(cell)).min(PI / 2.0);
-        let cells = (p.screen_resolution / cell).ceil() as i32 + 1;
-        let field = WindowField::new(&ScoreField::build(blocks, p.sigma_cells, penalty), cells as usize);
+        let penalty = (p.search.free_penalty.max(0.0) * f64::from(HIT)).round() as i16;
+        let step = (p.search.angle_step_scale * cell / scan.radius.max(cell)).min(PI / 2.0);
+        let cells = (p.search.screen_resolution / cell).ceil() as i32 + 1;
+        let field = WindowField::new(&ScoreField::build(blocks, p.search.sigma_cells, penalty), cells as usize);
         let window = LocalWindow { cells, angles: (coarse.step / step).ceil() as usize, angle_step: step };
         let mut buf = LocalScratch::default();
         let mut found: Vec<(usize, ScanPose, i64)> = coarse
@@ -231,13 +233,17 @@ impl CorrelativeMerger {
             |q: &ScanPose, k: &ScanPose| (q.tx - k.tx).hypot(q.ty - k.ty) + scan.radius * angle_gap(q.theta, k.theta);
         let mut kept: Vec<(ScanPose, i64)> = Vec::new();
         for (_, q, s) in &found {
-            if kept.iter().all(|(k, _)| apart(q, k) > p.distinct_m) && kept.len() < p.hypotheses.max(1) {
+            if kept.iter().all(|(k, _)| apart(q, k) > p.search.distinct_m) && kept.len() < p.answer.hypotheses.max(1) {
                 kept.push((*q, *s));
             }
         }
         let winner = kept[0].0;
-        let rivals: Vec<ScanPose> =
-            found.iter().map(|f| f.1).filter(|q| apart(q, &winner) > p.rival_distinct_m).take(p.rivals).collect();
+        let rivals: Vec<ScanPose> = found
+            .iter()
+            .map(|f| f.1)
+            .filter(|q| apart(q, &winner) > p.answer.rival_distinct_m)
+            .take(p.search.rivals)
+            .collect();
         let transform = |q: &ScanPose| to_transform(a, &scan.centroid, q);
         timings.insert("search_local".into(), ms(t));
         Ok(Found {

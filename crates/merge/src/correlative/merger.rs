@@ -64,7 +64,7 @@ impl CorrelativeMerger {
         let p = &self.params;
         let Candidates { refined, significance, scan_points, min_overlap_m2, .. } =
             self.settled(a, b, timings).map_err(NoAnswer::Unsettled)?;
-        if let Some(reason) = significance.refusal(p.min_margin) {
+        if let Some(reason) = significance.refusal(p.answer.min_margin) {
             let no = fail(reason, std::mem::take(timings));
             return Err(if significance.best_score > 0 { NoAnswer::Ambiguous(no) } else { NoAnswer::Unsettled(no) });
         }
@@ -76,9 +76,9 @@ impl CorrelativeMerger {
                 format!(
                     "no pose {}both shares {:.1} m² of known space and has an acceptance index of {:.2}: the {} \
                      best share {}",
-                    if p.min_margin > 0.0 { "(the best, as the significance test asks) " } else { "" },
+                    if p.answer.min_margin > 0.0 { "(the best, as the significance test asks) " } else { "" },
                     min_overlap_m2,
-                    p.min_acceptance,
+                    p.answer.min_acceptance,
                     tried.len(),
                     tried.join(", ")
                 ),
@@ -103,20 +103,23 @@ impl Merger for CorrelativeMerger {
     }
 
     /// The pipeline's gate with the wall agreement asked of its answers at most
-    /// [`CorrelativeParams::min_wall_agreement`].
+    /// [`crate::AnswerParams::min_wall_agreement`].
     fn gate(&self, verify: &VerifyParams) -> VerifyParams {
-        VerifyParams { min_wall_agreement: verify.min_wall_agreement.min(self.params.min_wall_agreement), ..*verify }
+        VerifyParams {
+            min_wall_agreement: verify.min_wall_agreement.min(self.params.answer.min_wall_agreement),
+            ..*verify
+        }
     }
 
     fn align(&self, a: &OccupancyGrid, b: &OccupancyGrid) -> Result<Alignment, Box<NoAlignment>> {
         let p = &self.params;
         let mut timings = BTreeMap::new();
         let (poses, points_b) = self.answers(a, b, &mut timings).map_err(NoAnswer::into_inner)?;
-        if p.cross_check {
+        if p.answer.cross_check {
             let t = Instant::now();
             let back = self.answers(b, a, &mut BTreeMap::new());
             timings.insert("cross_check".into(), ms(t));
-            if let Some(reason) = cross_check_refusal(&poses[0], &points_b, back, p.distinct_m) {
+            if let Some(reason) = cross_check_refusal(&poses[0], &points_b, back, p.search.distinct_m) {
                 return Err(fail(reason, timings));
             }
         }
@@ -143,7 +146,7 @@ impl Merger for CorrelativeMerger {
             timings_ms: timings,
             evidence: Evidence { points_a: Vec::new(), points_b, inlier_pairs: Vec::new() },
             alternatives: hypotheses.collect(),
-            alternatives_are_rivals: p.min_margin > 0.0,
+            alternatives_are_rivals: p.answer.min_margin > 0.0,
         })
     }
 }
@@ -153,12 +156,10 @@ mod tests {
     use super::*;
     use crate::correlative::params::CorrelativeParams;
     use crate::correlative::settle::{score_near, significance};
-    use crate::correlative::significance::Significance;
     use crate::floorplan::{FloorplanParams, generate};
     use crate::pairs::{PairSpec, cut_pair};
     use mrslam_core::pose;
     use mrslam_matching::WallScan;
-    use std::f64::consts::PI;
 
     /// Rotation (degrees) and translation (metres) errors of `t` against `truth`.
     fn error(t: &Pose2, truth: &Pose2) -> (f64, f64) {
@@ -211,7 +212,9 @@ mod tests {
         assert!(rival > 178.0, "rival {rival:.1} deg away");
         assert!(no.reason.contains(&format!("a pose {rival:.0} deg")), "{}", no.reason);
         // With the test off the old behaviour returns: an answer (one of the two) for the gate to judge.
-        let off = CorrelativeMerger::new(CorrelativeParams { min_margin: 0.0, ..CorrelativeParams::default() });
+        let mut off = CorrelativeParams::default();
+        off.answer.min_margin = 0.0;
+        let off = CorrelativeMerger::new(off);
         assert!(off.align(&g, &g).is_ok());
     }
 
@@ -219,7 +222,9 @@ mod tests {
     fn the_answer_is_checked_the_other_way_round() {
         let map = generate(5, &FloorplanParams { width_m: 16.0, height_m: 12.0, ..FloorplanParams::default() });
         let pair = cut_pair(&map, &PairSpec { overlap: 0.4, max_shift_m: 3.0, rotate: true }, 2);
-        let one_way = CorrelativeMerger::new(CorrelativeParams { cross_check: false, ..Default::default() });
+        let mut one_way = CorrelativeParams::default();
+        one_way.answer.cross_check = false;
+        let one_way = CorrelativeMerger::new(one_way);
         let forward = one_way.align(&pair.a, &pair.b).unwrap();
         let checked = CorrelativeMerger::default().align(&pair.a, &pair.b).unwrap();
         assert_eq!(checked.transform, forward.transform, "the check only accepts or refuses");
@@ -230,12 +235,15 @@ mod tests {
         // A map a with fewer wall blocks than b: asking for a count between the two, a into b is not searched;
         // nothing to check against, the answer stands.
         let blocks =
-            |g: &OccupancyGrid| WallScan::of_blocks(g, 8, CorrelativeParams::default().max_points).points.len();
+            |g: &OccupancyGrid| WallScan::of_blocks(g, 8, CorrelativeParams::default().search.max_points).points.len();
         let (na, nb) = (blocks(&pair.a), blocks(&pair.b));
         let (small, large) = if na < nb { (&pair.a, &pair.b) } else { (&pair.b, &pair.a) };
-        let between = CorrelativeParams { min_points: na.min(nb) + 1, ..Default::default() };
-        assert!(between.min_points <= na.max(nb), "the cuts have {na} and {nb} wall blocks");
-        let one_way = CorrelativeMerger::new(CorrelativeParams { cross_check: false, ..between });
+        let mut between = CorrelativeParams::default();
+        between.search.min_points = na.min(nb) + 1;
+        assert!(between.search.min_points <= na.max(nb), "the cuts have {na} and {nb} wall blocks");
+        let mut one_way = between;
+        one_way.answer.cross_check = false;
+        let one_way = CorrelativeMerger::new(one_way);
         let checked = CorrelativeMerger::new(between);
         assert_eq!(checked.align(small, large).unwrap().transform, one_way.align(small, large).unwrap().transform);
     }
@@ -261,7 +269,7 @@ mod tests {
         let g = building(true);
         let merger = CorrelativeMerger::default();
         let sig = significance(&merger, &g, &g).unwrap();
-        assert!(sig.margin() >= merger.params.min_margin, "margin {:.3}", sig.margin());
+        assert!(sig.margin() >= merger.params.answer.min_margin, "margin {:.3}", sig.margin());
         let al = merger.align(&g, &g).unwrap();
         let (deg, m) = error(&al.transform, &Pose2::identity());
         assert!(deg < 0.5 && m < 0.05, "off by {deg:.2} deg, {m:.3} m");
@@ -290,7 +298,9 @@ mod tests {
             }
         }
         let score = |share: f64, a: &OccupancyGrid| {
-            let merger = CorrelativeMerger::new(CorrelativeParams { dense_free_share: share, ..Default::default() });
+            let mut params = CorrelativeParams::default();
+            params.search.dense_free_share = share;
+            let merger = CorrelativeMerger::new(params);
             let (s, counts, _) = score_near(&merger, a, &b, &Pose2::identity());
             (s, counts[1])
         };
@@ -311,23 +321,5 @@ mod tests {
         // A gate that already asks less keeps its own.
         let lax = VerifyParams { min_wall_agreement: 0.3, ..gate };
         assert_eq!(merger.gate(&lax), lax);
-    }
-
-    #[test]
-    fn the_margin_is_the_winners_lead_over_its_rival() {
-        let s = |best, rival: Option<i64>| Significance {
-            best: Pose2::identity(),
-            best_score: best,
-            rival: rival.map(|_| pose(1.0, 2.0, PI)),
-            rival_score: rival.unwrap_or(0),
-        };
-        assert!((s(1000, Some(900)).margin() - 0.1).abs() < 1e-12);
-        assert_eq!(s(1000, Some(-50)).margin(), 1.0);
-        assert_eq!(s(1000, None).margin(), 1.0);
-        assert_eq!(s(-10, None).margin(), 0.0);
-        assert!(s(1000, Some(900)).refusal(0.0).is_none());
-        assert!(s(1000, Some(900)).refusal(0.05).is_none());
-        let why = s(1000, Some(900)).refusal(0.15).unwrap();
-        assert!(why.contains("180 deg") && why.contains("90% of it") && why.contains("lead by 15%"), "{why}");
     }
 }

@@ -24,7 +24,7 @@
 //! The shared pipeline then refines each answer by wall ICP and puts it through the verification gate.
 //!
 //! What the pipeline sees ([`Alignment`](crate::Alignment)): the evidence is b's wall cells (at a's resolution, thinned to
-//! [`CorrelativeParams::max_fine_points`]) placed by the transform. `matches` (and `matched_features`) = those
+//! [`crate::FineParams::max_points`]) placed by the transform. `matches` (and `matched_features`) = those
 //! landing on a known cell of a, `inliers` = those of them with a wall of a within one cell: the counts of
 //! the gate's wall agreement ([`crate::verify::wall_hits`]). m-explore's confidence
 //! `inliers / (8 + 0.3 · matches)` is then above 1 when more than 30 % of b's walls over a's known space meet
@@ -44,6 +44,6 @@ mod params;
 mod settle;
 mod significance;
 
-pub use params::{CorrelativeMerger, CorrelativeParams};
+pub use params::{AnswerParams, CorrelativeMerger, CorrelativeParams, FallbackParams, FineParams, SearchParams};
 pub use settle::{score_near, significance};
 pub use significance::Significance;

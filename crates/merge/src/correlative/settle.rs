@@ -6,7 +6,7 @@ use super::fine::{Candidates, FineCache, FineField};
 use super::geometry::{to_scan_pose, to_transform};
 use super::global::{Pooled, dense_free_cells};
 use super::orientation;
-use super::params::{CorrelativeMerger, CorrelativeParams};
+use super::params::{CorrelativeMerger, CorrelativeParams, SearchParams};
 use super::significance::Significance;
 use crate::merger::NoAlignment;
 use crate::verify::agreement;
@@ -33,14 +33,14 @@ pub fn score_near(
     t_a_b: &Pose2,
 ) -> (i64, [usize; 3], Pose2) {
     let p = &merger.params;
-    let fa = ((p.search_resolution / a.resolution()).round() as usize).max(1);
-    let fb = ((p.search_resolution / b.resolution()).round() as usize).max(1);
+    let fa = ((p.search.resolution / a.resolution()).round() as usize).max(1);
+    let fb = ((p.search.resolution / b.resolution()).round() as usize).max(1);
     let cell = fa as f64 * a.resolution();
-    let scan = WallScan::of_blocks(b, fb, p.max_points);
-    let penalty = (p.free_penalty.max(0.0) * f64::from(HIT)).round() as i16;
-    let field = ScoreField::build(&dense_free_cells(a, p).pooled(fa), p.sigma_cells, penalty);
+    let scan = WallScan::of_blocks(b, fb, p.search.max_points);
+    let penalty = (p.search.free_penalty.max(0.0) * f64::from(HIT)).round() as i16;
+    let field = ScoreField::build(&dense_free_cells(a, p).pooled(fa), p.search.sigma_cells, penalty);
     let grid = WindowField::new(&field, 2);
-    let step = (p.angle_step_scale * cell / scan.radius.max(cell)).min(PI / 2.0);
+    let step = (p.search.angle_step_scale * cell / scan.radius.max(cell)).min(PI / 2.0);
     let window = LocalWindow { cells: 2, angles: 2, angle_step: step };
     let start = to_scan_pose(a, &scan.centroid, t_a_b);
     let mut pts = Vec::new();
@@ -62,9 +62,9 @@ pub fn score_near(
 }
 
 impl CorrelativeMerger {
-    /// The candidates of the search with [`CorrelativeParams::free_penalty`]; when they do not settle the pair
+    /// The candidates of the search with [`crate::SearchParams::free_penalty`]; when they do not settle the pair
     /// (the best is not significant, or no hypothesis shares enough known space at the acceptance asked for),
-    /// pooled with those of a second search with [`CorrelativeParams::fallback_free_penalty`].
+    /// pooled with those of a second search with [`crate::FallbackParams::free_penalty`].
     pub(super) fn settled(
         &self,
         a: &OccupancyGrid,
@@ -74,11 +74,14 @@ impl CorrelativeMerger {
         let p = &self.params;
         let t = Instant::now();
         let cells_a = dense_free_cells(a, p);
-        let pooled = Pooled::build(a, &cells_a, b, p.search_resolution, p.max_points);
+        let pooled = Pooled::build(a, &cells_a, b, p.search.resolution, p.search.max_points);
         timings.insert("pool".into(), ms(t));
         let t = Instant::now();
-        let peaks =
-            if p.rotation_prior { orientation::rotation_peaks(a, b, p.rotation_peak_ratio) } else { Vec::new() };
+        let peaks = if p.search.rotation_prior {
+            orientation::rotation_peaks(a, b, p.search.rotation_peak_ratio)
+        } else {
+            Vec::new()
+        };
         timings.insert("orientation".into(), ms(t));
         let strict = self.search(a, &cells_a, b, &pooled, &peaks, timings)?;
         let t = Instant::now();
@@ -87,19 +90,18 @@ impl CorrelativeMerger {
         let mut cache = FineCache::default();
         let first = self.candidates(a, &fine, &[&strict], &mut cache, timings);
         let settles = |c: &Candidates| {
-            c.significance.refusal(p.min_margin).is_none()
+            c.significance.refusal(p.answer.min_margin).is_none()
                 && !self.shared(a, b, &c.refined, c.min_overlap_m2).0.is_empty()
         };
         let first_settles = settles(&first);
-        if p.fallback_free_penalty <= 0.0
-            || p.fallback_free_penalty == p.free_penalty
-            || (first_settles && !p.fallback_always)
+        if p.fallback.free_penalty <= 0.0
+            || p.fallback.free_penalty == p.search.free_penalty
+            || (first_settles && !p.fallback.always)
         {
             return Ok(first);
         }
         let tolerant = CorrelativeMerger::new(CorrelativeParams {
-            free_penalty: p.fallback_free_penalty,
-            rivals: p.fallback_rivals,
+            search: SearchParams { free_penalty: p.fallback.free_penalty, rivals: p.fallback.rivals, ..p.search },
             ..*p
         });
         let mut more = BTreeMap::new();
@@ -113,13 +115,13 @@ impl CorrelativeMerger {
         // A pose only the tolerant search found needs the larger shared area; the first search's settled answer,
         // now tested against the tolerant search's rivals too, keeps its own.
         if !first_settles || !pooled.best_from_first {
-            pooled.min_overlap_m2 = p.min_overlap_m2.max(p.fallback_min_overlap_m2);
+            pooled.min_overlap_m2 = p.answer.min_overlap_m2.max(p.fallback.min_overlap_m2);
         }
         Ok(pooled)
     }
 
-    /// The first [`CorrelativeParams::hypotheses`] of `refined` that share `min_m2` of known space at an
-    /// acceptance index of [`CorrelativeParams::min_acceptance`] (none unless the first does, with the
+    /// The first [`crate::AnswerParams::hypotheses`] of `refined` that share `min_m2` of known space at an
+    /// acceptance index of [`crate::AnswerParams::min_acceptance`] (none unless the first does, with the
     /// significance test on), and what each tried had.
     ///
     /// A pose found by trying every pose needs a shared area of some size to count: a small patch where the walls
@@ -136,16 +138,16 @@ impl CorrelativeMerger {
         let cell_m2 = a.resolution() * a.resolution();
         let mut tried = Vec::new();
         let mut poses = Vec::new();
-        for (t, _) in refined.iter().take(p.hypotheses.max(1)) {
+        for (t, _) in refined.iter().take(p.answer.hypotheses.max(1)) {
             let agr = agreement(a, b, t);
             let (m2, acc) = (agr.common() as f64 * cell_m2, agr.acceptance_index());
             tried.push(format!("{m2:.1} m² at {acc:.3}"));
-            if m2 >= min_m2 && acc >= p.min_acceptance {
+            if m2 >= min_m2 && acc >= p.answer.min_acceptance {
                 poses.push(*t);
             }
         }
         // With the significance test on, only the best may be accepted: a weaker answer led nothing.
-        if p.min_margin > 0.0 && poses.first() != refined.first().map(|r| &r.0) {
+        if p.answer.min_margin > 0.0 && poses.first() != refined.first().map(|r| &r.0) {
             poses.clear();
         }
         (poses, tried)

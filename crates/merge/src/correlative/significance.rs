@@ -10,7 +10,7 @@ pub struct Significance {
     pub best: Pose2,
     /// Its fine score.
     pub best_score: i64,
-    /// The best answer more than [`CorrelativeParams::rival_distinct_m`] away, among the global search's
+    /// The best answer more than [`crate::AnswerParams::rival_distinct_m`] away, among the global search's
     /// answers above its pruning floor; None when there was none.
     pub rival: Option<Pose2>,
     /// Its fine score (0 when there was none).
@@ -60,5 +60,30 @@ impl Significance {
             100.0 * self.rival_score as f64 / self.best_score.max(1) as f64,
             100.0 * min_margin
         ))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use mrslam_core::pose;
+    use std::f64::consts::PI;
+
+    #[test]
+    fn the_margin_is_the_winners_lead_over_its_rival() {
+        let s = |best, rival: Option<i64>| Significance {
+            best: Pose2::identity(),
+            best_score: best,
+            rival: rival.map(|_| pose(1.0, 2.0, PI)),
+            rival_score: rival.unwrap_or(0),
+        };
+        assert!((s(1000, Some(900)).margin() - 0.1).abs() < 1e-12);
+        assert_eq!(s(1000, Some(-50)).margin(), 1.0);
+        assert_eq!(s(1000, None).margin(), 1.0);
+        assert_eq!(s(-10, None).margin(), 0.0);
+        assert!(s(1000, Some(900)).refusal(0.0).is_none());
+        assert!(s(1000, Some(900)).refusal(0.05).is_none());
+        let why = s(1000, Some(900)).refusal(0.15).unwrap();
+        assert!(why.contains("180 deg") && why.contains("90% of it") && why.contains("lead by 15%"), "{why}");
     }
 }

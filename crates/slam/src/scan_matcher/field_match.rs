@@ -29,7 +29,7 @@ impl ScanMatcher {
         // first angular steps turn the robot, widened by the margin. Sampled every margin along the arc, so
         // the discs cover a band about the arc rather than the disc around the end point a long beam's arc
         // spans (at 30 m, a band a metre wide instead of a disc 9 m across).
-        let turn = self.heading_search + 2.0 * self.astep;
+        let turn = self.params.heading_search + 2.0 * self.params.astep;
         let near = scan.hits.iter().flat_map(move |b| {
             let (ex, ey) = (lp.x + c * b.x - s * b.y - p.x, lp.y + s * b.x + c * b.y - p.y);
             let arm = ex.hypot(ey);
@@ -42,7 +42,7 @@ impl ScanMatcher {
         });
         let (a, b) = map.cell_of(x0 - FIELD_MARGIN, y0 - FIELD_MARGIN);
         let (c, d) = map.cell_of(x1 + FIELD_MARGIN, y1 + FIELD_MARGIN);
-        field.build_near(map, [a, b, c, d], self.field_reach, self.field_lines, near);
+        field.build_near(map, [a, b, c, d], self.params.field_reach, self.params.field_lines, near);
     }
 
     /// Score, log-likelihood and matched beams of robot pose `p` on a likelihood field.
@@ -52,8 +52,8 @@ impl ScanMatcher {
         let (s, c) = lp.theta.sin_cos();
         let (ox, oy) = f.origin();
         let (lx, ly) = (lp.x - ox, lp.y - oy);
-        let inv_sigma = 1.0 / self.sigma;
-        let inv_lsigma = 1.0 / self.lsigma;
+        let inv_sigma = 1.0 / self.params.sigma;
+        let inv_lsigma = 1.0 / self.params.lsigma;
         let unknown = self.unknown_score;
         let mut e = Evaluation::default();
         for b in beams {
@@ -77,7 +77,7 @@ impl ScanMatcher {
     /// steps towards the nearest maximum of the score.
     pub fn refine(&self, f: &Field, p: &Xyt, beams: &[Beam], prior: Option<&PosePrior>) -> Xyt {
         let mut p = *p;
-        for _ in 0..self.refine_iterations {
+        for _ in 0..self.params.refine_iterations {
             let (mut h, mut g) = self.normal_equations(f, &p, beams);
             if let Some(pr) = prior {
                 let d = pr.delta(&p);
@@ -111,7 +111,7 @@ impl ScanMatcher {
     /// The normal matrix (upper triangle) and gradient of the beams' weighted squared distances at `p`.
     fn normal_equations(&self, f: &Field, p: &Xyt, beams: &[Beam]) -> (Information, [f64; 3]) {
         let (ox, oy) = f.origin();
-        let inv_sigma = 1.0 / self.sigma;
+        let inv_sigma = 1.0 / self.params.sigma;
         // residuals in metres with the kernel's variance sigma/2: weights w·2/sigma in chi-square units
         let scale = 2.0 * inv_sigma;
         let lp = self.laser_pose(p);
