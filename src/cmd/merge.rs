@@ -67,7 +67,7 @@ pub struct MergeArgs {
     pub boundary_walls: BoundaryWalls,
     /// The correlative merger's significance test: its best pose must score this share above every pose clearly
     /// apart from it (Lowe's ratio test), else the merge is refused as ambiguous, naming the rival; 0 turns the
-    /// test off [default: `CorrelativeParams::default().min_margin`, 0.15].
+    /// test off [default: `AnswerParams::default().min_margin`, 0.15].
     #[arg(long, value_parser = margin)]
     pub min_margin: Option<f64>,
     /// The correlative merger's answer is not checked by the same search the other way round (the other map's
@@ -164,8 +164,8 @@ pub fn run(args: MergeArgs) -> Result<ExitCode> {
     };
     params.ransac.seed = args.seed;
     let mut correlative = CorrelativeParams::default();
-    correlative.min_margin = args.min_margin.unwrap_or(correlative.min_margin);
-    correlative.cross_check = !args.one_way;
+    correlative.answer.min_margin = args.min_margin.unwrap_or(correlative.answer.min_margin);
+    correlative.answer.cross_check = !args.one_way;
     let merger: Box<dyn Merger> = match args.algorithm {
         Algorithm::Sift => Box::new(SiftMerger::new(params)),
         Algorithm::Rmap => {

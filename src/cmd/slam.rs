@@ -65,7 +65,8 @@ pub struct SlamArgs {
     #[arg(long)]
     pub max_urange: Option<f64>,
     /// Set any SLAM parameter by its name, as in scenario files (repeatable; applied after the preset and the
-    /// flags above): e.g. `--set odometry_calibration=20 --set srr=0.2`.
+    /// flags above): a dotted name (`matcher.sigma`, `filter.particles`) or GMapping's flat one (`sigma`,
+    /// `particles`, `srr`): e.g. `--set odometry_calibration=20 --set motion.srr=0.2`.
     #[arg(long = "set", value_name = "NAME=VALUE")]
     pub set: Vec<String>,
     /// Odometry errors added to the log's (testing).
@@ -156,16 +157,16 @@ pub fn run(args: SlamArgs) -> Result<ExitCode> {
     args.drift.validate()?;
     let mut params = args.preset.params();
     if let Some(n) = args.particles {
-        params.particles = n;
+        params.filter.particles = n;
     }
     if let Some(v) = args.linear_update {
-        params.linear_update = v;
+        params.filter.linear_update = v;
     }
     if let Some(v) = args.angular_update {
-        params.angular_update = v;
+        params.filter.angular_update = v;
     }
     if let Some(v) = args.max_urange {
-        params.max_urange = v;
+        params.map.max_urange = v;
     }
     for kv in &args.set {
         let Some((name, value)) = kv.split_once('=') else {
@@ -278,7 +279,7 @@ pub fn run(args: SlamArgs) -> Result<ExitCode> {
             args.log.display(),
             trajectory.len(),
             processed.len(),
-            if filter.params().scan_odometry { "scan-matched odometry" } else { "odometry" },
+            if filter.params().scan_odometry.enabled { "scan-matched odometry" } else { "odometry" },
             if loops.is_some_and(|l| l.closures > 0) {
                 "\nThe processed scans' poses are the loop-closed (smoothed) ones."
             } else {
@@ -322,9 +323,9 @@ pub fn run(args: SlamArgs) -> Result<ExitCode> {
         secs * 1e3 / c.processed.max(1) as f64,
         peak.map_or("unknown".to_string(), |b| format!("{:.0} MiB", b as f64 / (1024.0 * 1024.0))),
         filter.neff(),
-        filter.params().particles
+        filter.params().filter.particles
     );
-    if filter.params().scan_odometry {
+    if filter.params().scan_odometry.enabled {
         let (matched, dead) = filter.scan_odometry_counts();
         println!("scan odometry: {matched} scans matched, {dead} kept the raw odometry's increment");
     }
@@ -335,7 +336,7 @@ pub fn run(args: SlamArgs) -> Result<ExitCode> {
             l.candidates, c.processed, l.closures, l.max_correction, l.iterations
         );
     }
-    if filter.params().odometry_calibration > 0.0 {
+    if filter.params().filter.odometry_calibration > 0.0 {
         let [scale, heading] = filter.odometry_calibration();
         println!(
             "odometry calibration learnt: distance scale {:+.2} %, heading drift {:+.4} rad/m",
@@ -359,7 +360,7 @@ pub fn run(args: SlamArgs) -> Result<ExitCode> {
             "log": args.log.display().to_string(),
             "preset": args.preset.to_string(),
             "seed": args.seed,
-            "particles": filter.params().particles,
+            "particles": filter.params().filter.particles,
             "scans": c.readings,
             "processed": c.processed,
             "resamples": c.resamples,
@@ -379,7 +380,7 @@ pub fn run(args: SlamArgs) -> Result<ExitCode> {
                 "line_odometry": r.line_odometry,
             },
             "odometry_jumps": jumps.len(),
-            "scan_odometry": filter.params().scan_odometry.then(|| {
+            "scan_odometry": filter.params().scan_odometry.enabled.then(|| {
                 let (matched, dead) = filter.scan_odometry_counts();
                 json!({ "matched": matched, "raw": dead })
             }),

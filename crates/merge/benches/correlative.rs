@@ -8,7 +8,7 @@
 use criterion::{Criterion, criterion_group, criterion_main};
 use mrslam_merge::floorplan::{FloorplanParams, generate};
 use mrslam_merge::pairs::{PairSpec, cut_pair};
-use mrslam_merge::{Cascade, CorrelativeMerger, CorrelativeParams, MergeParams, Merger, merge};
+use mrslam_merge::{Cascade, CorrelativeMerger, CorrelativeParams, MergeParams, Merger, SearchParams, merge};
 use std::hint::black_box;
 
 fn bench_correlative(c: &mut Criterion) {
@@ -44,8 +44,10 @@ fn bench_correlative(c: &mut Criterion) {
         out.report.accepted, out.report.stage, out.report.timings_ms
     );
     assert!(out.report.accepted && out.report.stage.as_deref() == Some("correlative"), "{:?}", out.report.reason);
-    let every_rotation =
-        CorrelativeMerger::new(CorrelativeParams { rotation_prior: false, ..CorrelativeParams::default() });
+    let every_rotation = CorrelativeMerger::new(CorrelativeParams {
+        search: SearchParams { rotation_prior: false, ..SearchParams::default() },
+        ..CorrelativeParams::default()
+    });
     let mut g = c.benchmark_group("cascade_18x14_low_overlap");
     g.bench_function("cascade", |b| b.iter(|| merge(&cascade, black_box(&pair.a), black_box(&pair.b), &params)));
     g.bench_function("correlative", |b| b.iter(|| merge(&parallel, black_box(&pair.a), black_box(&pair.b), &params)));

@@ -49,7 +49,7 @@ mod verify;
 pub use algorithm::{Algorithm, UnknownAlgorithm};
 pub use boundary_walls::BoundaryWalls;
 pub use cascade::{Cascade, Stage};
-pub use correlative::{CorrelativeMerger, CorrelativeParams};
+pub use correlative::{AnswerParams, CorrelativeMerger, CorrelativeParams, FallbackParams, FineParams, SearchParams};
 pub use estimate::{Model, RansacParams};
 pub use fuse::FusionRule;
 pub use map_image::{MapEncoding, MapImage};

@@ -1,4 +1,4 @@
-//! Online odometry calibration ([`crate::SlamParams::odometry_calibration`]; not GMapping).
+//! Online odometry calibration ([`crate::FilterParams::odometry_calibration`]; not GMapping).
 //!
 //! Model: a raw odometry increment (dx, dy, dθ) is corrected to ((1+a)·dx, (1+a)·dy, dθ + b·dx): a distance
 //! scale error a (wheel radii, slip) and a heading drift b per metre driven forward (unequal wheel radii).
@@ -17,6 +17,7 @@
 use mrslam_core::Xyt;
 use mrslam_core::pose::normalize_angle;
 use mrslam_core::{Pose2, pose};
+use mrslam_matching::Information;
 
 /// Prior standard deviation of each calibration parameter (distance scale error, heading drift in rad/m)
 /// around 0, in the information units of the motion prior (those of the `field` matcher's score): a few
@@ -49,10 +50,10 @@ pub(crate) struct CalibrationMatch {
     pub start: Xyt,
     /// The particle's pose at the previous update.
     pub previous: Xyt,
-    /// The scan's information at m (upper triangle 00 01 02 11 12 22, map frame).
-    pub scan: [f64; 6],
-    /// The motion prior's information (same layout).
-    pub prior: [f64; 6],
+    /// The scan's information at m (map frame).
+    pub scan: Information,
+    /// The motion prior's information.
+    pub prior: Information,
     /// The particle's normalised weight.
     pub weight: f64,
 }
@@ -128,15 +129,15 @@ impl OdometryCalibration {
     }
 }
 
-/// Adds the upper-triangle 3x3 symmetric matrix `m` times `w` to `acc`.
-fn add_sym(acc: &mut [f64; 6], m: &[f64; 6], w: f64) {
+/// Adds the symmetric 3x3 matrix `m` times `w` to `acc`.
+fn add_sym(acc: &mut Information, m: &Information, w: f64) {
     for k in 0..6 {
         acc[k] += w * m[k];
     }
 }
 
-/// The symmetric 3x3 matrix (upper triangle) times vector `v`.
-fn sym_mul(m: &[f64; 6], v: &[f64; 3]) -> [f64; 3] {
+/// The symmetric 3x3 matrix `m` times vector `v`.
+fn sym_mul(m: &Information, v: &[f64; 3]) -> [f64; 3] {
     [
         m[0] * v[0] + m[1] * v[1] + m[2] * v[2],
         m[1] * v[0] + m[3] * v[1] + m[4] * v[2],

@@ -5,7 +5,7 @@
 pub enum SlamError {
     /// A parameter is outside its domain.
     #[error("bad parameter: {0}")]
-    BadParams(String),
+    BadParams(#[from] crate::params::ParamError),
     /// The laser's mount pose is not finite.
     #[error("laser offset is not finite")]
     BadLaserOffset,

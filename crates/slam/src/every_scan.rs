@@ -61,7 +61,7 @@ pub fn map_log<'a>(
         }
         on_reading(&out, filter);
     }
-    let loop_closure = filter.params().loop_closure.then(|| filter.close_loops());
+    let loop_closure = filter.params().loop_closure.enabled.then(|| filter.close_loops());
     let keyframes = filter.trajectory();
     debug_assert_eq!(keyframes.len(), processed.len(), "one trajectory node per processed scan");
     let anchors: Vec<(usize, Pose2)> = processed.iter().copied().zip(keyframes.into_iter().map(|(_, p)| p)).collect();

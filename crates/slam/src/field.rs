@@ -25,7 +25,7 @@
 //! Without this test a surface just coming out of a pillar's shadow gets matched to the pillar's far face.
 //!
 //! Cells with no surfel within reach keep whether the particle's map has seen them (see
-//! [`crate::SlamParams::seen_band`]). The field is rebuilt for each particle at each update into reused
+//! [`crate::MatcherParams::seen_band`]). The field is rebuilt for each particle at each update into reused
 //! buffers ([`Field::build`]), which are never cleared: slots carry the number of the build that wrote them.
 //! It is derived data, never shared or stored; results do not depend on which buffer a build reuses.
 

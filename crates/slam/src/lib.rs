@@ -12,7 +12,7 @@
 //! go into each particle's copy-on-write `tile_map` → a new `particle` trajectory node.
 //! The output map ([`Rbpf::map`]) is rebuilt by `map_build` from the best particle's trajectory; with
 //! `loop_closure` on, [`map_log`] first smooths that trajectory ([`Rbpf::close_loops`]: `loop_closure` finds
-//! loop edges, `pose_graph` optimises).
+//! loop edges, `mrslam_matching::pose_graph` optimises).
 //!
 //! Modules are private: the items below are the API; [`synthetic`] (test data) is a public namespace and
 //! [`dev`] holds internals public only for the development probes (`dev/` in the repository).
@@ -47,7 +47,6 @@ mod map_build;
 mod motion;
 mod params;
 mod particle;
-mod pose_graph;
 mod rbpf;
 mod resample;
 mod scan_matcher;
@@ -57,9 +56,13 @@ mod tile_map;
 
 pub use error::SlamError;
 pub use every_scan::{LogRun, LogRunError, map_log, poses_at_every_scan};
-pub use loop_closure::LoopClosureReport;
-pub use params::{MatcherKind, Preset, SlamParams};
+pub use loop_closure::{LoopClosureParams, LoopClosureReport};
+pub use map_build::MapParams;
+pub use motion::MotionModel;
+pub use params::{FLAT_NAMES, FilterParams, ParamError, Preset, SlamParams};
 pub use rbpf::{Counters, MemoryStats, Rbpf, SkipReason, UpdateOutcome, UpdateStats};
+pub use scan_matcher::{MatcherKind, MatcherParams};
+pub use scan_odometry::ScanOdometryParams;
 
 /// Internals public only for the development probes (`dev/src/bin/matcher_lab.rs`, `matcher_check.rs`): the
 /// scan matcher on a hand-built tile map. Not part of the crate's API; the filter ([`Rbpf`]) is.

@@ -15,14 +15,76 @@
 //! filter put the scan), so the filter must have kept the loop within that window: loop closure corrects a
 //! filter's residual drift, it does not replace the filter.
 
-use crate::params::SlamParams;
+use crate::map_build::MapParams;
 use crate::particle::TrajectoryNode;
-use crate::pose_graph::{Edge, optimize};
-use crate::scan_matcher::{Beam, PreparedScan, ScanMatcher, Scratch};
+use crate::scan_matcher::{Beam, MatcherParams, PreparedScan, ScanMatcher, Scratch};
 use crate::tile_map::TileMap;
 use mrslam_core::Xyt;
 use mrslam_core::pose::relative;
+use mrslam_matching::Information;
+use mrslam_matching::pose_graph::{Edge, optimize};
 use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+/// Loop closure's settings (not GMapping).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct LoopClosureParams {
+    /// `loop_closure`: when the log ends, smooth the best particle's trajectory with a pose graph whose loop
+    /// edges match each processed scan against the scans around the place it passed a loop ago (see
+    /// `loop_closure`), and map from the smoothed poses. Off (the default): the filter's trajectory, as
+    /// GMapping.
+    pub enabled: bool,
+    /// `loop_min_travel`, metres driven: a place is a loop ago when the robot drove at least this far since it
+    /// passed there.
+    pub min_travel: f64,
+    /// `loop_search_radius`, metres: a scan is matched against the place passed a loop ago nearest to it, when
+    /// nearer than this.
+    pub search_radius: f64,
+    /// `loop_submap_nodes`: the local map of a place is the processed scans within this many of it, before and
+    /// after.
+    pub submap_nodes: usize,
+    /// `loop_window`, metres: the loop match searches translations within ± this of where the filter put the
+    /// scan.
+    pub window: f64,
+    /// `loop_heading_window`, radians: the loop match searches headings within ± this.
+    pub heading_window: f64,
+    /// `loop_min_matched`: a loop match is kept when at least this fraction of the scan's beams found a surface
+    /// of the local map.
+    pub min_matched: f64,
+    /// `loop_chain_sigma`, metres: the standard deviation of the filter's own increment between two processed
+    /// scans (each axis), as the pose graph's chain trusts it.
+    pub chain_sigma: f64,
+    /// `loop_chain_heading_sigma`, radians: the same for the increment's heading.
+    pub chain_heading_sigma: f64,
+    /// `loop_sigma`, metres: added (in quadrature, each axis) to a loop match's standard deviation from the
+    /// matcher's information, which counts every beam as independent.
+    pub sigma: f64,
+    /// `loop_heading_sigma`, radians: the same for the loop match's heading.
+    pub heading_sigma: f64,
+    /// `loop_range`, metres: beams longer than this (or than the map's `max_urange`) are not used by the loop
+    /// matches.
+    pub range: f64,
+}
+
+impl Default for LoopClosureParams {
+    fn default() -> Self {
+        LoopClosureParams {
+            enabled: false,
+            min_travel: 20.0,
+            search_radius: 3.0,
+            submap_nodes: 10,
+            window: 0.4,
+            heading_window: 0.05,
+            min_matched: 0.6,
+            chain_sigma: 0.01,
+            chain_heading_sigma: 0.003,
+            sigma: 0.02,
+            heading_sigma: 0.005,
+            range: 30.0,
+        }
+    }
+}
 
 /// What loop closure did.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -44,33 +106,40 @@ const MAX_ITERATIONS: u32 = 30;
 /// Beams of the translation and heading search: every this many (the climb and Gauss-Newton use all).
 const SEARCH_STRIDE: usize = 3;
 
-/// Smooths a trajectory (oldest node first) by loop closure with the `loop_*` settings of `params`;
-/// returns the new poses, one per node. Poses are unchanged when no loop edge is found.
-pub fn close_loops(nodes: &[&TrajectoryNode], laser: Xyt, params: &SlamParams) -> (Vec<Xyt>, LoopClosureReport) {
+/// Smooths a trajectory (oldest node first) by loop closure with settings `params`, matching with the filter's
+/// `matcher` set up for one scan alone on grids and ranges of `map`; returns the new poses, one per node. Poses
+/// are unchanged when no loop edge is found.
+pub fn close_loops(
+    nodes: &[&TrajectoryNode],
+    laser: Xyt,
+    params: &LoopClosureParams,
+    matcher: &MatcherParams,
+    map: &MapParams,
+) -> (Vec<Xyt>, LoopClosureReport) {
     let mut poses: Vec<Xyt> = nodes.iter().map(|n| n.pose).collect();
     let mut report = LoopClosureReport::default();
     if nodes.len() < 3 {
         return (poses, report);
     }
-    let range = params.max_urange.min(params.loop_range);
+    let range = map.max_urange.min(params.range);
     let prepared: Vec<PreparedScan> = nodes
         .par_iter()
-        .map(|n| PreparedScan::new(&n.scan, params.max_range.min(n.scan.range_max as f64), range, 0))
+        .map(|n| PreparedScan::new(&n.scan, map.max_range.min(n.scan.range_max as f64), range, 0))
         .collect();
     // Distance driven up to each node.
     let mut travel = vec![0.0; nodes.len()];
     for k in 1..nodes.len() {
         travel[k] = travel[k - 1] + (poses[k].x - poses[k - 1].x).hypot(poses[k].y - poses[k - 1].y);
     }
-    let matcher = loop_matcher(params, laser);
+    let search = LoopSearch { matcher: loop_matcher(params, matcher, laser), params, delta: map.delta };
     // For each scan, the nearest node passed a loop ago, within the radius.
     let candidates: Vec<(usize, usize)> = (0..nodes.len())
         .filter_map(|j| {
             let p = &poses[j];
             (0..j)
-                .filter(|&i| travel[j] - travel[i] >= params.loop_min_travel)
+                .filter(|&i| travel[j] - travel[i] >= params.min_travel)
                 .map(|i| (i, (poses[i].x - p.x).hypot(poses[i].y - p.y)))
-                .filter(|&(_, d)| d <= params.loop_search_radius)
+                .filter(|&(_, d)| d <= params.search_radius)
                 .min_by(|a, b| a.1.total_cmp(&b.1))
                 .map(|(i, _)| (i, j))
         })
@@ -79,25 +148,24 @@ pub fn close_loops(nodes: &[&TrajectoryNode], laser: Xyt, params: &SlamParams) -
     let loops: Vec<Edge> = candidates
         .par_iter()
         .filter_map(|&(i, j)| {
-            let lo = i.saturating_sub(params.loop_submap_nodes);
-            let hi = (i + params.loop_submap_nodes).min(j);
-            let submap: Vec<usize> =
-                (lo..=hi).filter(|&k| travel[j] - travel[k] >= 0.5 * params.loop_min_travel).collect();
-            match_loop(&matcher, params, &poses, &prepared, &submap, i, j)
+            let lo = i.saturating_sub(params.submap_nodes);
+            let hi = (i + params.submap_nodes).min(j);
+            let submap: Vec<usize> = (lo..=hi).filter(|&k| travel[j] - travel[k] >= 0.5 * params.min_travel).collect();
+            match_loop(&search, &poses, &prepared, &submap, i, j)
         })
         .collect();
     report.closures = loops.len();
     if loops.is_empty() {
         return (poses, report);
     }
-    let chain_info = [
-        1.0 / (params.loop_chain_sigma * params.loop_chain_sigma),
+    let chain_info = Information([
+        1.0 / (params.chain_sigma * params.chain_sigma),
         0.0,
         0.0,
-        1.0 / (params.loop_chain_sigma * params.loop_chain_sigma),
+        1.0 / (params.chain_sigma * params.chain_sigma),
         0.0,
-        1.0 / (params.loop_chain_heading_sigma * params.loop_chain_heading_sigma),
-    ];
+        1.0 / (params.chain_heading_sigma * params.chain_heading_sigma),
+    ]);
     let mut edges: Vec<Edge> = (1..nodes.len())
         .map(|k| Edge {
             from: k - 1,
@@ -116,11 +184,17 @@ pub fn close_loops(nodes: &[&TrajectoryNode], laser: Xyt, params: &SlamParams) -
     (poses, report)
 }
 
+/// What every loop match uses: the matcher, the settings and the grid's cell size.
+struct LoopSearch<'a> {
+    matcher: ScanMatcher,
+    params: &'a LoopClosureParams,
+    delta: f64,
+}
+
 /// The field matcher the loop search uses: the filter's kernel and reach, no prior, every beam.
-fn loop_matcher(params: &SlamParams, laser: Xyt) -> ScanMatcher {
-    let p =
-        SlamParams { heading_search: params.loop_heading_window, motion_prior: 0.0, ..params.field_matcher_alone() };
-    ScanMatcher::from_params(&p, laser)
+fn loop_matcher(params: &LoopClosureParams, matcher: &MatcherParams, laser: Xyt) -> ScanMatcher {
+    let p = MatcherParams { heading_search: params.heading_window, motion_prior: 0.0, ..matcher.alone() };
+    ScanMatcher::new(p, laser, false)
 }
 
 /// Matches node `j`'s scan against the map of the `submap` nodes' scans (at their current poses) around
@@ -128,8 +202,7 @@ fn loop_matcher(params: &SlamParams, laser: Xyt) -> ScanMatcher {
 /// where the filter put it, then the climb and Gauss-Newton. Returns the loop edge i → j when at least
 /// `loop_min_matched` of the beams found a surface there.
 fn match_loop(
-    matcher: &ScanMatcher,
-    params: &SlamParams,
+    search: &LoopSearch,
     poses: &[Xyt],
     prepared: &[PreparedScan],
     submap: &[usize],
@@ -140,7 +213,8 @@ fn match_loop(
     if scan.matched.len() < 10 || submap.is_empty() {
         return None;
     }
-    let mut map = TileMap::new(params.delta);
+    let &LoopSearch { ref matcher, params, delta } = search;
+    let mut map = TileMap::new(delta);
     for &k in submap {
         let lp = matcher.laser_pose(&poses[k]);
         let (s, c) = lp.theta.sin_cos();
@@ -154,11 +228,11 @@ fn match_loop(
     matcher.build_field(&map, &init, scan, &mut scratch.field);
     let f = &scratch.field;
     let sparse: Vec<Beam> = scan.matched.iter().step_by(SEARCH_STRIDE).copied().collect();
-    let steps = (params.loop_window / params.delta).floor() as i32;
+    let steps = (params.window / delta).floor() as i32;
     let mut best = (f64::NEG_INFINITY, init);
     for iy in -steps..=steps {
         for ix in -steps..=steps {
-            let shifted = Xyt { x: init.x + ix as f64 * params.delta, y: init.y + iy as f64 * params.delta, ..init };
+            let shifted = Xyt { x: init.x + ix as f64 * delta, y: init.y + iy as f64 * delta, ..init };
             let q = matcher.sweep_heading(&shifted, |q| matcher.field_eval(f, q, &sparse).score);
             let s = matcher.field_eval(f, &q, &sparse).score;
             if s > best.0 {
@@ -171,7 +245,7 @@ fn match_loop(
     let (at_climbed, at_refined) =
         (matcher.field_eval(f, &climbed, &scan.matched), matcher.field_eval(f, &refined, &scan.matched));
     let (pose, e) = if at_refined.score >= at_climbed.score { (refined, at_refined) } else { (climbed, at_climbed) };
-    if (e.matched as f64) < params.loop_min_matched * scan.matched.len() as f64 {
+    if (e.matched as f64) < params.min_matched * scan.matched.len() as f64 {
         return None;
     }
     let h = matcher.scan_information(f, &pose, &scan.matched);
@@ -187,21 +261,21 @@ fn match_loop(
 /// A loop edge's information from the scan's information `h` about the robot's pose (map frame): rotated into
 /// the robot's frame at heading `theta`, its covariance widened by `loop_sigma` and `loop_heading_sigma` (the
 /// matcher's information counts every beam as independent, which they are not).
-fn loop_information(h: &[f64; 6], theta: f64, params: &SlamParams) -> [f64; 6] {
+fn loop_information(h: &Information, theta: f64, params: &LoopClosureParams) -> Information {
     let (s, c) = theta.sin_cos();
     // Rᵀ H R for the translation block, Rᵀ h_tθ for the coupling.
-    let m = nalgebra::Matrix3::new(h[0], h[1], h[2], h[1], h[3], h[4], h[2], h[4], h[5]);
+    let m = h.matrix();
     let r = nalgebra::Matrix3::new(c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0);
     let local = r.transpose() * m * r;
     let eps = 1e-9 * (local[(0, 0)] + local[(1, 1)] + local[(2, 2)]).max(1e-12);
     let cov = (local + nalgebra::Matrix3::identity() * eps).try_inverse().unwrap_or(nalgebra::Matrix3::zeros());
     let floor = nalgebra::Matrix3::from_diagonal(&nalgebra::Vector3::new(
-        params.loop_sigma * params.loop_sigma,
-        params.loop_sigma * params.loop_sigma,
-        params.loop_heading_sigma * params.loop_heading_sigma,
+        params.sigma * params.sigma,
+        params.sigma * params.sigma,
+        params.heading_sigma * params.heading_sigma,
     ));
     let info = (cov + floor).try_inverse().unwrap_or(nalgebra::Matrix3::zeros());
-    [info[(0, 0)], info[(0, 1)], info[(0, 2)], info[(1, 1)], info[(1, 2)], info[(2, 2)]]
+    Information::from_matrix(&info)
 }
 
 #[cfg(test)]
@@ -269,8 +343,9 @@ mod tests {
         assert!((0.15..0.4).contains(&end_before), "the lap must end off, within the window: {end_before} m");
         let nodes = nodes(&drifted, &scans);
         let refs: Vec<&TrajectoryNode> = nodes.iter().collect();
-        let params = SlamParams { max_range: 30.0, max_urange: 30.0, ..SlamParams::matched() };
-        let (smoothed, report) = close_loops(&refs, laser, &params);
+        let params = crate::SlamParams::matched();
+        let map = MapParams { max_range: 30.0, max_urange: 30.0, ..params.map };
+        let (smoothed, report) = close_loops(&refs, laser, &params.loop_closure, &params.matcher, &map);
         let (worst_after, end_after) = error_to(&truth, &smoothed);
         assert!(report.closures >= 3, "{report:?}");
         assert!(end_after < 0.04, "the lap's end {end_after} m from the truth (was {end_before} m), {report:?}");
@@ -283,14 +358,15 @@ mod tests {
         let poses: Vec<Xyt> = truth.iter().map(Xyt::from_pose).collect();
         let nodes = nodes(&poses, &scans);
         let refs: Vec<&TrajectoryNode> = nodes.iter().collect();
-        let params = SlamParams { max_range: 30.0, max_urange: 30.0, ..SlamParams::matched() };
-        let (smoothed, report) = close_loops(&refs, laser, &params);
+        let params = crate::SlamParams::matched();
+        let map = MapParams { max_range: 30.0, max_urange: 30.0, ..params.map };
+        let (smoothed, report) = close_loops(&refs, laser, &params.loop_closure, &params.matcher, &map);
         assert!(report.closures >= 3, "{report:?}");
         let (worst, _) = error_to(&truth, &smoothed);
         assert!(worst < 0.03, "the smoothing moved a true pose {worst} m");
         // Fewer metres than `loop_min_travel`: nothing to close.
         let short: Vec<&TrajectoryNode> = refs.iter().take(10).copied().collect();
-        let (same, report) = close_loops(&short, laser, &params);
+        let (same, report) = close_loops(&short, laser, &params.loop_closure, &params.matcher, &map);
         assert_eq!(report.closures, 0);
         assert_eq!(same, poses[..10].to_vec());
     }

@@ -10,15 +10,53 @@
 //! least `wall_hits` beams of the trajectory ended in: beams that passed through glass, or past a wall's
 //! edge at a grazing angle, then no longer carve free space behind the wall.
 
-use crate::params::SlamParams;
 use crate::particle::TrajectoryNode;
 use mrslam_core::MAX_CELLS;
 use mrslam_core::Xyt;
 use mrslam_core::map_io::ROS_LOGODDS_LIMIT;
 use mrslam_core::{CellTraversal, LaserScan, OccupancyGrid, pose};
+use serde::{Deserialize, Serialize};
+
+/// The grid and the ranges of the beams it is built from (the particles' maps and the output map).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct MapParams {
+    /// `delta`: grid resolution, metres per cell (GMapping 0.05).
+    pub delta: f64,
+    /// `maxRange`: beams at or beyond this range (metres) are max-range readings: never hits; they clear
+    /// free space up to `max_urange` when `clear_max_range` is set (GMapping 80).
+    pub max_range: f64,
+    /// `maxUrange`: usable range, metres: longer beams are not matched and are clipped here when mapping
+    /// free space (GMapping 80).
+    pub max_urange: f64,
+    /// Whether no-return beams (at or beyond the sensor's / `max_range`) clear free space up to `max_urange`
+    /// in the output map. Off by default, as GMapping ignores readings beyond maxRange: on real logs
+    /// no-return beams (glass, black surfaces, open doors) would spray free space outside the building.
+    /// Beams between `max_urange` and `max_range` always clear up to `max_urange`.
+    pub clear_max_range: bool,
+    /// `occ_thresh`: a cell of the output map is occupied when hits/visits exceeds this (GMapping 0.25).
+    pub occ_thresh: f64,
+    /// Not GMapping: `wall_hits`: in the output map a beam's free-space trace stops at the first cell on its
+    /// way that at least this many beams ended in (see `map_build`); 0: traces run to the end
+    /// point, as GMapping's.
+    pub wall_hits: u32,
+}
+
+impl Default for MapParams {
+    fn default() -> Self {
+        MapParams {
+            delta: 0.05,
+            max_range: 80.0,
+            max_urange: 80.0,
+            clear_max_range: false,
+            occ_thresh: 0.25,
+            wall_hits: 0,
+        }
+    }
+}
 
 /// Where a beam ends for mapping, and whether that end is a hit.
-fn beam_end(scan: &LaserScan, i: usize, params: &SlamParams) -> Option<(f64, bool)> {
+fn beam_end(scan: &LaserScan, i: usize, params: &MapParams) -> Option<(f64, bool)> {
     let r = scan.ranges[i] as f64;
     let max_range = params.max_range.min(scan.range_max as f64);
     if scan.is_valid(i) && r < max_range {
@@ -40,7 +78,7 @@ fn sensor(p: &Xyt, laser: &Xyt) -> Xyt {
 ///
 /// Returns a 1×1 unknown grid when there is nothing to map, and `None` when the map would exceed
 /// core's cell limit.
-pub fn build_map(nodes: &[&TrajectoryNode], laser: &Xyt, params: &SlamParams) -> Option<OccupancyGrid> {
+pub fn build_map(nodes: &[&TrajectoryNode], laser: &Xyt, params: &MapParams) -> Option<OccupancyGrid> {
     let inv = 1.0 / params.delta;
     // Pass 1: bounds in cells.
     let (mut x0, mut y0, mut x1, mut y1) = (i64::MAX, i64::MAX, i64::MIN, i64::MIN);
@@ -168,14 +206,14 @@ mod tests {
             .collect();
         let refs: Vec<&TrajectoryNode> = nodes.iter().collect();
         let laser = Xyt { x: 0.0, y: 0.0, theta: 0.0 };
-        let state_at = |params: &SlamParams, x: f64| {
+        let state_at = |params: &MapParams, x: f64| {
             let map = build_map(&refs, &laser, params).unwrap();
             let p = nalgebra::Point2::new(x, 0.0);
             let (cx, cy) = map.world_to_cell(&p).unwrap();
             map.state(cx, cy)
         };
-        let gmapping = SlamParams::default();
-        let walls = SlamParams { wall_hits: 2, ..SlamParams::default() };
+        let gmapping = MapParams::default();
+        let walls = MapParams { wall_hits: 2, ..MapParams::default() };
         for params in [&gmapping, &walls] {
             assert_eq!(state_at(params, 2.0 + 0.02), mrslam_core::CellState::Occupied, "the wall stays a wall");
             assert_eq!(state_at(params, 1.0), mrslam_core::CellState::Free);

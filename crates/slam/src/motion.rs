@@ -5,18 +5,26 @@ use mrslam_core::{Pose2, pose, pose::normalize_angle};
 use mrslam_core::{Xyt, pose::relative};
 use rand::Rng;
 use rand_distr::StandardNormal;
+use serde::{Deserialize, Serialize};
 
-/// GMapping's odometry noise parameters (see [`crate::SlamParams`]).
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// GMapping's odometry noise parameters, named as GMapping's except `str` (`trans_from_rot`); defaults GMapping's.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct MotionModel {
-    /// Translation error from translation.
+    /// `srr`: odometry translation error from translation (GMapping 0.1).
     pub srr: f64,
-    /// Rotation error from translation.
+    /// `srt`: odometry rotation error from translation, rad/m (GMapping 0.2).
     pub srt: f64,
-    /// Translation error from rotation.
-    pub str: f64,
-    /// Rotation error from rotation.
+    /// GMapping's `str`: odometry translation error from rotation, m/rad (GMapping 0.1).
+    pub trans_from_rot: f64,
+    /// `stt`: odometry rotation error from rotation (GMapping 0.2).
     pub stt: f64,
+}
+
+impl Default for MotionModel {
+    fn default() -> Self {
+        MotionModel { srr: 0.1, srt: 0.2, trans_from_rot: 0.1, stt: 0.2 }
+    }
 }
 
 /// A zero-mean Gaussian draw of standard deviation `sigma` (0 when sigma is 0, as GMapping's).
@@ -32,7 +40,7 @@ impl MotionModel {
     /// Samples a new pose for a particle at `p` given the odometry moved from `old` to `new`.
     ///
     /// GMapping's formula: the increment `delta = old⁻¹ ⊕ new` (in the old odometry frame) gets noise
-    /// `x += N(srr|dx| + str|dθ| + 0.3·srr|dy|)`, `y += N(srr|dy| + str|dθ| + 0.3·srr|dx|)`,
+    /// `x += N(srr|dx| + str|dθ| + 0.3·srr|dy|)`, `y += N(srr|dy| + str|dθ| + 0.3·srr|dx|)` (`str`: `trans_from_rot`),
     /// `θ += N(stt|dθ| + srt·|(dx, dy)|)` (standard deviations), and is composed onto `p`.
     #[cfg(test)]
     pub fn draw_from_motion<R: Rng>(&self, rng: &mut R, p: &Pose2, new: &Pose2, old: &Pose2) -> Pose2 {
@@ -44,8 +52,8 @@ impl MotionModel {
     pub fn sigmas(&self, dx: f64, dy: f64, dt: f64) -> [f64; 3] {
         let sxy = 0.3 * self.srr;
         [
-            self.srr * dx.abs() + self.str * dt.abs() + sxy * dy.abs(),
-            self.srr * dy.abs() + self.str * dt.abs() + sxy * dx.abs(),
+            self.srr * dx.abs() + self.trans_from_rot * dt.abs() + sxy * dy.abs(),
+            self.srr * dy.abs() + self.trans_from_rot * dt.abs() + sxy * dx.abs(),
             self.stt * dt.abs() + self.srt * dx.hypot(dy),
         ]
     }
@@ -68,7 +76,7 @@ mod tests {
 
     #[test]
     fn no_motion_no_noise() {
-        let m = MotionModel { srr: 0.1, srt: 0.2, str: 0.1, stt: 0.2 };
+        let m = MotionModel { srr: 0.1, srt: 0.2, trans_from_rot: 0.1, stt: 0.2 };
         let mut rng = ChaCha8Rng::seed_from_u64(1);
         let p = pose(1.0, 2.0, 0.3);
         let q = m.draw_from_motion(&mut rng, &p, &pose(5.0, 5.0, 1.0), &pose(5.0, 5.0, 1.0));
@@ -77,7 +85,7 @@ mod tests {
 
     #[test]
     fn spread_follows_srr() {
-        let m = MotionModel { srr: 0.1, srt: 0.2, str: 0.1, stt: 0.2 };
+        let m = MotionModel { srr: 0.1, srt: 0.2, trans_from_rot: 0.1, stt: 0.2 };
         let mut rng = ChaCha8Rng::seed_from_u64(7);
         let n = 20_000;
         let (mut sx, mut sxx, mut st) = (0.0, 0.0, 0.0);

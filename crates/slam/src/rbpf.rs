@@ -8,7 +8,7 @@ use crate::motion::MotionModel;
 use crate::params::SlamParams;
 use crate::particle::{Particle, TrajectoryNode, ancestry};
 use crate::resample::{normalize, systematic};
-use crate::scan_matcher::{MatchResult, MotionPrior, PreparedScan, ScanMatcher, Scratch};
+use crate::scan_matcher::{MatchInformation, MatchResult, MotionPrior, PreparedScan, ScanMatcher, Scratch};
 use crate::scan_odometry::ScanOdometry;
 use mrslam_core::{LaserScan, OccupancyGrid, Odometry, Pose2};
 use mrslam_core::{Xyt, pose::relative};
@@ -159,7 +159,7 @@ pub struct Rbpf {
     angular_distance: f64,
     /// Variances (robot frame x, y, heading) the motion model added since the last processed scan.
     motion_var: [f64; 3],
-    /// Odometry calibration (see [`SlamParams::odometry_calibration`]).
+    /// Odometry calibration (see [`crate::FilterParams::odometry_calibration`]).
     calibration: OdometryCalibration,
     /// Scan-matched odometry (see [`SlamParams::scan_odometry`]).
     scan_odometry: Option<ScanOdometry>,
@@ -174,12 +174,15 @@ impl Rbpf {
         if !(laser.x.is_finite() && laser.y.is_finite() && laser.theta.is_finite()) {
             return Err(SlamError::BadLaserOffset);
         }
-        let matcher = ScanMatcher::from_params(&params, laser);
-        let motion = MotionModel { srr: params.srr, srt: params.srt, str: params.str, stt: params.stt };
-        let n = params.particles;
-        let scan_odometry = params.scan_odometry.then(|| ScanOdometry::new(&params, laser));
+        let matcher = ScanMatcher::new(params.matcher, laser, params.filter.odometry_calibration > 0.0);
+        let motion = params.motion;
+        let n = params.filter.particles;
+        let scan_odometry = params
+            .scan_odometry
+            .enabled
+            .then(|| ScanOdometry::new(&params.scan_odometry, &params.matcher, &params.map, params.motion, laser));
         Ok(Rbpf {
-            particles: (0..n).map(|_| Particle::new(params.delta)).collect(),
+            particles: (0..n).map(|_| Particle::new(params.map.delta)).collect(),
             weights: vec![1.0 / n as f64; n],
             neff: n as f64,
             params,
@@ -251,7 +254,7 @@ impl Rbpf {
         };
 
         let raw = Xyt::from_pose(&relative(&odo_pose, &odom.pose));
-        let Xyt { x: dx, y: dy, theta: dt } = if self.params.odometry_calibration > 0.0 {
+        let Xyt { x: dx, y: dy, theta: dt } = if self.params.filter.odometry_calibration > 0.0 {
             let corrected = self.calibration.correct(raw);
             self.calibration.record(raw, corrected);
             corrected
@@ -275,9 +278,9 @@ impl Rbpf {
             return Ok(UpdateOutcome::Skipped(SkipReason::EmptyScan));
         }
         let p = &self.params;
-        let due = self.linear_distance >= p.linear_update
-            || self.angular_distance >= p.angular_update
-            || (p.temporal_update >= 0.0 && scan.stamp - self.last_update_stamp > p.temporal_update);
+        let due = self.linear_distance >= p.filter.linear_update
+            || self.angular_distance >= p.filter.angular_update
+            || (p.filter.temporal_update >= 0.0 && scan.stamp - self.last_update_stamp > p.filter.temporal_update);
         if !due {
             self.counters.skipped_not_moved += 1;
             let prepared_invalid = (0..scan.len()).filter(|&i| !scan.is_valid(i) && !scan.is_max_range(i)).count();
@@ -329,7 +332,8 @@ impl Rbpf {
     /// Matches, weighs, resamples and maps one scan.
     fn update(&mut self, scan: &LaserScan, first: bool) -> Result<UpdateOutcome, SlamError> {
         let p = &self.params;
-        let prepared = PreparedScan::new(scan, p.max_range.min(scan.range_max as f64), p.max_urange, p.lskip);
+        let prepared =
+            PreparedScan::new(scan, p.map.max_range.min(scan.range_max as f64), p.map.max_urange, p.matcher.lskip);
         self.counters.invalid_beams += prepared.invalid;
         let n = self.particles.len();
         let mut matched_particles = 0;
@@ -349,7 +353,7 @@ impl Rbpf {
             // Each particle's match is independent of the others': computed in parallel, collected in order,
             // so results do not depend on the number of threads (the scratch holds only rebuilt data).
             // The calibration learns from where each match started and the information at its end.
-            let calibrating = self.params.odometry_calibration > 0.0;
+            let calibrating = self.params.filter.odometry_calibration > 0.0;
             let starts: Vec<Xyt> =
                 if calibrating { self.particles.iter().map(|q| q.pose).collect() } else { Vec::new() };
             let results: Vec<MatchResult> = self
@@ -364,7 +368,7 @@ impl Rbpf {
                     m
                 })
                 .collect();
-            let information: Vec<Option<([f64; 6], [f64; 6])>> =
+            let information: Vec<Option<MatchInformation>> =
                 if calibrating { results.iter().map(|m| m.information).collect() } else { Vec::new() };
             for (part, m) in self.particles.iter_mut().zip(results) {
                 if m.accepted {
@@ -375,7 +379,7 @@ impl Rbpf {
                 part.weight += m.likelihood;
                 part.weight_sum += m.likelihood;
             }
-            let gain = 1.0 / (self.params.ogain * n as f64);
+            let gain = 1.0 / (self.params.filter.ogain * n as f64);
             let logw: Vec<f64> = self.particles.iter().map(|q| q.weight).collect();
             let (w, ne) = normalize(&logw, gain);
             neff = ne;
@@ -383,7 +387,7 @@ impl Rbpf {
             if calibrating {
                 self.calibrate(&starts, &information);
             }
-            if neff < self.params.resample_threshold * n as f64 {
+            if neff < self.params.filter.resample_threshold * n as f64 {
                 let u: f64 = self.rng.random();
                 let idx = systematic(&self.weights, n, u);
                 let mut next = Vec::with_capacity(n);
@@ -405,10 +409,10 @@ impl Rbpf {
         // own). The seen band of a beam whose end point lies within half a cell of the last banded beam's
         // adds nothing at this resolution and is skipped (the same beams for every particle).
         let shared_scan = Arc::new(scan.clone());
-        let band = self.params.seen_band;
+        let band = self.params.matcher.seen_band;
         let mut banded = vec![false; prepared.hits.len()];
         if band > 0.0 {
-            let gap = 0.5 * self.params.delta;
+            let gap = 0.5 * self.params.map.delta;
             let mut last: Option<(f64, f64)> = None;
             for (flag, b) in banded.iter_mut().zip(&prepared.hits) {
                 if last.is_none_or(|(x, y)| (b.x - x) * (b.x - x) + (b.y - y) * (b.y - y) >= gap * gap) {
@@ -470,10 +474,12 @@ impl Rbpf {
     /// `starts` are the particles' motion-model samples, `information` the matcher's scan and prior
     /// information at each match. Runs once the update's weights are known, before resampling and mapping
     /// (the particles' trajectory nodes still end at the previous update).
-    fn calibrate(&mut self, starts: &[Xyt], information: &[Option<([f64; 6], [f64; 6])>]) {
+    fn calibrate(&mut self, starts: &[Xyt], information: &[Option<MatchInformation>]) {
         let matches = self.particles.iter().zip(starts).zip(information).zip(&self.weights).filter_map(
             |(((part, start), info), &weight)| {
-                let (Some((scan, prior)), Some(node)) = (info, part.node.as_ref()) else { return None };
+                let (Some(MatchInformation { scan, prior }), Some(node)) = (info, part.node.as_ref()) else {
+                    return None;
+                };
                 Some(CalibrationMatch {
                     matched: part.pose,
                     start: *start,
@@ -484,7 +490,7 @@ impl Rbpf {
                 })
             },
         );
-        self.calibration.update(matches, self.params.odometry_calibration);
+        self.calibration.update(matches, self.params.filter.odometry_calibration);
     }
 
     /// The odometry calibration's current estimate: distance scale error a and heading drift b (rad per metre
@@ -555,7 +561,13 @@ impl Rbpf {
         let part = &self.particles[best];
         let mut nodes: Vec<&TrajectoryNode> = ancestry(&part.node).collect();
         nodes.reverse();
-        let (poses, report) = crate::loop_closure::close_loops(&nodes, self.laser, &self.params);
+        let (poses, report) = crate::loop_closure::close_loops(
+            &nodes,
+            self.laser,
+            &self.params.loop_closure,
+            &self.params.matcher,
+            &self.params.map,
+        );
         if report.closures == 0 {
             return report;
         }
@@ -592,7 +604,7 @@ impl Rbpf {
     /// `map_update_interval`): cost grows with the scans processed, so call it when a map is needed.
     pub fn map(&self) -> Result<OccupancyGrid, SlamError> {
         let nodes: Vec<&TrajectoryNode> = ancestry(&self.particles[self.best_index()].node).collect();
-        build_map(&nodes, &self.laser, &self.params)
+        build_map(&nodes, &self.laser, &self.params.map)
             .ok_or_else(|| SlamError::MapTooLarge("the trajectory's map exceeds core's grid size limit".into()))
     }
 

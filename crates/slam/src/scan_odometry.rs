@@ -19,18 +19,49 @@
 //! (GMapping's noise model over that increment, with floors), so a direction the scan does not observe
 //! (along a featureless corridor) keeps the odometry's increment.
 
+use crate::map_build::MapParams;
 use crate::motion::MotionModel;
-use crate::params::SlamParams;
+use crate::scan_matcher::MatcherParams;
 use crate::scan_matcher::{MotionPrior, PreparedScan, ScanMatcher, Scratch};
 use crate::tile_map::TileMap;
 use mrslam_core::{LaserScan, Pose2};
 use mrslam_core::{Xyt, pose, pose::relative};
+use serde::{Deserialize, Serialize};
 
 /// Smallest standard deviations (x, y metres; heading radians) of the prior on an increment: a robot
 /// that did not move by its odometry may still have moved a little.
 const MIN_PRIOR_SIGMA: [f64; 3] = [0.01, 0.01, 0.01];
 /// A match is used only when at least this fraction of the matched beams found a surface at the result.
 const MIN_MATCHED_FRACTION: f64 = 0.3;
+
+/// Scan-matched odometry's settings (not GMapping).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ScanOdometryParams {
+    /// `scan_odometry`: match every scan against a local map of the scans before it and move the particles by
+    /// the matched increments instead of the raw odometry's (see `scan_odometry`). Off (the default): raw
+    /// odometry, as GMapping.
+    pub enabled: bool,
+    /// `scan_odometry_submap`: scans per submap of the local map (it matches against the last `submap` to
+    /// 2 × `submap` scans).
+    pub submap: usize,
+    /// `scan_odometry_range`, metres: beams longer than this (or than `max_urange`) are not used.
+    pub range: f64,
+    /// `scan_odometry_sigma`: the matcher's score sigma (as the matcher's `sigma`, m²).
+    pub sigma: f64,
+    /// `scan_odometry_heading_search`, radians: the matcher tries headings within ± this of the odometry's
+    /// before it climbs (0: off).
+    pub heading_search: f64,
+    /// `scan_odometry_reach`, cells: the field reach (as the matcher's `field_reach`). Its increments are
+    /// centimetres, so a short reach suffices, and its field is built for every scan.
+    pub reach: i32,
+}
+
+impl Default for ScanOdometryParams {
+    fn default() -> Self {
+        ScanOdometryParams { enabled: false, submap: 60, range: 30.0, sigma: 0.001, heading_search: 0.1, reach: 3 }
+    }
+}
 
 /// What scan-matched odometry did with one scan.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -67,25 +98,32 @@ pub struct ScanOdometry {
 }
 
 impl ScanOdometry {
-    /// Scan-matched odometry with the `scan_odometry_*` settings of `params`, for a laser mounted at `laser`.
-    pub fn new(params: &SlamParams, laser: Xyt) -> Self {
-        let matcher_params = SlamParams {
-            sigma: params.scan_odometry_sigma,
-            heading_search: params.scan_odometry_heading_search,
+    /// Scan-matched odometry with settings `so`, its matcher set up from the filter's `matcher` for one scan
+    /// alone, on grids and ranges of `map`, its prior from `noise`, for a laser mounted at `laser`.
+    pub fn new(
+        so: &ScanOdometryParams,
+        matcher: &MatcherParams,
+        map: &MapParams,
+        noise: MotionModel,
+        laser: Xyt,
+    ) -> Self {
+        let matcher_params = MatcherParams {
+            sigma: so.sigma,
+            heading_search: so.heading_search,
             motion_prior: 1.0,
-            field_reach: params.scan_odometry_reach,
-            ..params.field_matcher_alone()
+            field_reach: so.reach,
+            ..matcher.alone()
         };
         ScanOdometry {
-            matcher: ScanMatcher::from_params(&matcher_params, laser),
-            delta: params.delta,
-            max_range: params.max_range,
-            max_urange: params.scan_odometry_range.min(params.max_urange),
-            submap_scans: params.scan_odometry_submap.max(1),
-            submaps: [(TileMap::new(params.delta), 0), (TileMap::new(params.delta), 0)],
+            matcher: ScanMatcher::new(matcher_params, laser, false),
+            delta: map.delta,
+            max_range: map.max_range,
+            max_urange: so.range.min(map.max_urange),
+            submap_scans: so.submap.max(1),
+            submaps: [(TileMap::new(map.delta), 0), (TileMap::new(map.delta), 0)],
             last_raw: None,
             pose: Xyt { x: 0.0, y: 0.0, theta: 0.0 },
-            noise: MotionModel { srr: params.srr, srt: params.srt, str: params.str, stt: params.stt },
+            noise,
             scratch: Scratch::default(),
             inserted: 0,
             matched: 0,
@@ -196,8 +234,9 @@ mod tests {
             }
             run.odometry[i].pose *= wrong;
         }
-        let params = SlamParams { scan_odometry: true, ..SlamParams::default() };
-        let mut so = ScanOdometry::new(&params, Xyt { x: 0.1, y: 0.0, theta: 0.0 });
+        let params = crate::SlamParams::default();
+        let laser = Xyt { x: 0.1, y: 0.0, theta: 0.0 };
+        let mut so = ScanOdometry::new(&params.scan_odometry, &params.matcher, &params.map, params.motion, laser);
         let mut corrected = Vec::new();
         let mut steps = Vec::new();
         for (o, s) in run.odometry.iter().zip(&run.scans) {

@@ -73,6 +73,14 @@ fn drifting() -> Drift {
     Drift { scale: 0.03, heading_per_m: 0.01, sigma_trans: 0.02, sigma_rot: 0.01 }
 }
 
+/// `p` with parameters set by name.
+fn with(mut p: SlamParams, sets: &[(&str, &str)]) -> SlamParams {
+    for (name, value) in sets {
+        p.set(name, value).unwrap();
+    }
+    p
+}
+
 fn run_filter(run: &SyntheticRun, params: SlamParams, seed: u64) -> Rbpf {
     let mut f = Rbpf::new(params, run.laser_offset, seed).unwrap();
     for (o, s) in run.odometry.iter().zip(&run.scans) {
@@ -121,8 +129,10 @@ fn hokuyo_with_odometry_calibration_meets_the_target() {
     // learnt online (their error no longer leaks through the motion prior): 0.014 m on this run, 0.020 m mean
     // and 0.043 m worst over synthetic-data seeds 11-14 x filter seeds 1-4 (BENCHMARKS.md).
     let run = office_run(&drifting(), 11);
-    let params =
-        SlamParams { linear_update: 0.1, angular_update: 0.1, odometry_calibration: 20.0, ..SlamParams::hokuyo() };
+    let params = with(
+        SlamParams::hokuyo(),
+        &[("linear_update", "0.1"), ("angular_update", "0.1"), ("odometry_calibration", "20")],
+    );
     let f = run_filter(&run, params, 5);
     let traj = f.trajectory();
     let slam_rms = rms_error(&traj, &run.truth);
@@ -190,7 +200,7 @@ fn update_schedule_and_events() {
     let run = office_run(&drifting(), 2);
     // A sharp likelihood and a high threshold, so that this short run resamples: with GMapping's `lsigma`
     // the weights of this run stay even (see BENCHMARKS.md).
-    let params = SlamParams { resample_threshold: 0.9, lsigma: 0.002, ..SlamParams::hokuyo() };
+    let params = with(SlamParams::hokuyo(), &[("resample_threshold", "0.9"), ("lsigma", "0.002")]);
     let mut f = Rbpf::new(params, run.laser_offset, 1).unwrap();
     assert_eq!(f.neff(), 30.0);
     let mut processed = 0;
@@ -262,7 +272,7 @@ fn bad_input_is_refused_or_counted() {
     }
     assert!(f.trajectory().len() > 3);
     // bad parameters
-    let p = SlamParams { particles: 0, ..SlamParams::hokuyo() };
+    let p = with(SlamParams::hokuyo(), &[("particles", "0")]);
     assert!(Rbpf::new(p, run.laser_offset, 1).is_err());
     assert!(Rbpf::new(SlamParams::hokuyo(), pose(f64::INFINITY, 0.0, 0.0), 1).is_err());
     // an all-invalid scan is processed as "nothing seen" without panicking
@@ -281,7 +291,7 @@ fn results_do_not_depend_on_the_number_of_threads() {
     let on = |threads: usize| {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
         // a sharp likelihood, so that resampling (and tile sharing) is part of what is compared
-        let params = SlamParams { lsigma: 0.002, ..SlamParams::hokuyo() };
+        let params = with(SlamParams::hokuyo(), &[("lsigma", "0.002")]);
         let f = pool.install(|| run_filter(&run, params, 3));
         let poses: Vec<(u64, u64, u64)> = f
             .particles()
@@ -302,15 +312,17 @@ fn gmappings_matcher_stays_reachable() {
     // GMapping's defaults with the sensor's range and a short update distance: the kernel-search matcher and
     // hill climbing, GMapping's likelihood; it must still beat the drifting odometry on the first corridor.
     let run = office_run_first(300, &drifting(), 11);
-    let params = SlamParams {
-        max_range: 4.0,
-        max_urange: 4.0,
-        linear_update: 0.25,
-        angular_update: 0.25,
-        lskip: 3,
-        ..SlamParams::default()
-    };
-    assert_eq!(params.matcher, mrslam_slam::MatcherKind::Gmapping);
+    let params = with(
+        SlamParams::default(),
+        &[
+            ("max_range", "4"),
+            ("max_urange", "4"),
+            ("linear_update", "0.25"),
+            ("angular_update", "0.25"),
+            ("lskip", "3"),
+        ],
+    );
+    assert_eq!(params.matcher.kind, mrslam_slam::MatcherKind::Gmapping);
     let f = run_filter(&run, params, 5);
     let traj = f.trajectory();
     let (slam, odom) = (rms_error(&traj, &run.truth), rms_error(&odometry_at(&run, &traj), &run.truth));
@@ -323,7 +335,7 @@ fn odometry_calibration_learns_the_drift_and_is_off_by_default() {
     // The synthetic odometry reports 3 % more distance and turns 0.01 rad per metre: the calibrated
     // increments are (1+a)·d with a = 1/1.03 - 1 = -0.029, and dθ + b·dx with b = -0.01/1.03 = -0.0097.
     let run = office_run_first(400, &drifting(), 11);
-    let params = SlamParams { odometry_calibration: 20.0, ..SlamParams::hokuyo() };
+    let params = with(SlamParams::hokuyo(), &[("odometry_calibration", "20")]);
     let f = run_filter(&run, params, 5);
     let [a, b] = f.odometry_calibration();
     eprintln!("calibration after the first corridor: scale {a:+.4}, heading {b:+.4} rad/m");
@@ -359,7 +371,7 @@ fn matched_preset_closes_the_loop_on_every_seed() {
         "odometry must drift for this test to mean anything: {odo_rms} {odo_end}"
     );
     // The scan odometry alone (the filter never updates after the first scan): a lap's drift of centimetres.
-    let params = SlamParams { linear_update: 1e9, angular_update: 1e9, ..SlamParams::matched() };
+    let params = with(SlamParams::matched(), &[("linear_update", "1e9"), ("angular_update", "1e9")]);
     let mut f = Rbpf::new(params, run.laser_offset, 0).unwrap();
     let mut matched = Vec::new();
     for (o, s) in run.odometry.iter().zip(&run.scans) {

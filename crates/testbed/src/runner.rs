@@ -198,7 +198,7 @@ pub fn run(scenario: &Scenario, mut opts: RunOptions) -> Result<RunOutput, RunEr
     }
     // A robot whose SLAM parameters ask for loop closure gets it when the drive ends, as `mrslam slam` does
     // at the end of a log (no preset of the simulated robots turns it on).
-    for a in agents.iter_mut().filter(|a| a.slam.params().loop_closure) {
+    for a in agents.iter_mut().filter(|a| a.slam.params().loop_closure.enabled) {
         a.slam.close_loops();
     }
     let evaluated = evaluate_robots(&agents, &truth, &mut opts)?;

@@ -551,12 +551,12 @@ fn resolve_slam(cx: &Ctx, field: &str, s: &SlamFile, lidar: &LidarModel) -> Resu
                 );
             }
         };
-        p.set(name, &text).map_err(|e| cx.err(format!("{field}.{name}"), e))?;
+        p.set(name, &text).map_err(|e| cx.err(format!("{field}.{name}"), e.to_string()))?;
     }
     // The filter sees no farther than the lidar.
-    p.max_range = p.max_range.min(lidar.range_max);
-    p.max_urange = p.max_urange.min(lidar.range_max);
-    p.validate().map_err(|e| cx.err(field, e))?;
+    p.map.max_range = p.map.max_range.min(lidar.range_max);
+    p.map.max_urange = p.map.max_urange.min(lidar.range_max);
+    p.validate().map_err(|e| cx.err(field, e.to_string()))?;
     Ok(p)
 }
 
@@ -700,11 +700,11 @@ mod tests {
         let s = two_rooms(|t| t).unwrap();
         assert_eq!(s.robots[0].slam, {
             let mut p = SlamParams::hokuyo();
-            p.max_range = p.max_range.min(s.robots[0].lidar.range_max);
-            p.max_urange = p.max_urange.min(s.robots[0].lidar.range_max);
+            p.map.max_range = p.map.max_range.min(s.robots[0].lidar.range_max);
+            p.map.max_urange = p.map.max_urange.min(s.robots[0].lidar.range_max);
             p
         });
-        assert!(!s.robots[1].slam.scan_odometry);
+        assert!(!s.robots[1].slam.scan_odometry.enabled);
         // A preset and parameters by name; the 80 m preset is capped at the robot's lidar.
         let table =
             "slam = { preset = \"matched\", particles = 12, scan_odometry_reach = 2, linear_update = \"0.4\" }\n";
@@ -714,13 +714,13 @@ mod tests {
         })
         .unwrap();
         let (slam, range) = (&s.robots[1].slam, s.robots[1].lidar.range_max);
-        assert!(slam.scan_odometry, "the matched preset");
-        assert_eq!((slam.particles, slam.scan_odometry_reach, slam.linear_update), (12, 2, 0.4));
+        assert!(slam.scan_odometry.enabled, "the matched preset");
+        assert_eq!((slam.filter.particles, slam.scan_odometry.reach, slam.filter.linear_update), (12, 2, 0.4));
         assert!(
-            slam.max_range <= range && slam.max_urange <= range,
+            slam.map.max_range <= range && slam.map.max_urange <= range,
             "{} {} > {range}",
-            slam.max_range,
-            slam.max_urange
+            slam.map.max_range,
+            slam.map.max_urange
         );
         // An unknown parameter or a bad value names the robot's table, the parameter and its line.
         let refused = |table: &str| {

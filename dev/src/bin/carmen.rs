@@ -55,7 +55,7 @@ fn main() {
             }
         }
     }
-    if f.params().loop_closure {
+    if f.params().loop_closure.enabled {
         let t = std::time::Instant::now();
         let r = f.close_loops();
         println!("loop closure: {r:?} in {:.2} s", t.elapsed().as_secs_f64());

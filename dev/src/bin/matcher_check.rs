@@ -12,10 +12,8 @@ fn main() {
     let map = synthetic::office_map();
     let path = synthetic::waypoint_path(&synthetic::office_loop(), 0.05, 0.1);
     let run = synthetic::simulate(&map, &path, 0.1, &Lidar::hokuyo(), pose(0.0, 0.0, 0.0), &Drift::none(), 1);
-    let m = ScanMatcher {
-        sigma: env("SIGMA", 0.05),
-        ..ScanMatcher::from_params(&mrslam_slam::SlamParams::default(), Xyt { x: 0.0, y: 0.0, theta: 0.0 })
-    };
+    let params = mrslam_slam::MatcherParams { sigma: env("SIGMA", 0.05), ..Default::default() };
+    let m = ScanMatcher::new(params, Xyt { x: 0.0, y: 0.0, theta: 0.0 }, false);
     // map from the first 150 true scans
     let mut tm = TileMap::new(0.05);
     let upto = env("UPTO", 150.0) as usize;

@@ -10,7 +10,7 @@ use mrslam_slam::SlamParams;
 use mrslam_slam::dev::TileMap;
 use mrslam_slam::synthetic::{self, Drift, Lidar};
 use mrslam_slam::{
-    MatcherKind,
+    MatcherKind, MatcherParams,
     dev::{PreparedScan, ScanMatcher},
 };
 use rand::SeedableRng;
@@ -60,11 +60,13 @@ fn main() {
             _ => params.set(k, v).unwrap(),
         }
     }
-    let matcher = ScanMatcher {
-        minimum_score: f64::NEG_INFINITY,
-        ..ScanMatcher::from_params(&params, Xyt::from_pose(&run.laser_offset))
-    };
-    let mut tm = TileMap::new(params.delta);
+    let laser = Xyt::from_pose(&run.laser_offset);
+    let matcher = ScanMatcher::new(
+        MatcherParams { minimum_score: f64::NEG_INFINITY, ..params.matcher },
+        laser,
+        params.filter.odometry_calibration > 0.0,
+    );
+    let mut tm = TileMap::new(params.map.delta);
     let mut rng = ChaCha8Rng::seed_from_u64(3);
     let (nl, na) = (Normal::new(0.0, lin).unwrap(), Normal::new(0.0, ang).unwrap());
     let (mut sx, mut sy, mut st, mut ax, mut ay, mut at, mut n) = (0.0f64, 0.0, 0.0, 0.0f64, 0.0f64, 0.0f64, 0.0);
@@ -76,7 +78,7 @@ fn main() {
     let mut prev_truth: Option<Xyt> = None;
     for k in (0..run.scans.len()).step_by(every) {
         let truth = Xyt::from_pose(&run.truth[k].1);
-        let ps = PreparedScan::new(&run.scans[k], params.max_range, params.max_urange, params.lskip);
+        let ps = PreparedScan::new(&run.scans[k], params.map.max_range, params.map.max_urange, params.matcher.lskip);
         let pe: usize = std::env::var("PROFILE").ok().and_then(|v| v.parse().ok()).unwrap_or(0);
         if pe > 0
             && k >= 4 * every
@@ -135,7 +137,7 @@ fn main() {
                         let w = l.y - oy + s * b.x + c * b.y;
                         match f.lookup(u, w, c * b.c - s * b.s, s * b.c + c * b.s) {
                             mrslam_slam::dev::Lookup::Hit(d2) => {
-                                ((-d2 / params.sigma).exp(), format!("hit {:.4}", d2.sqrt()))
+                                ((-d2 / params.matcher.sigma).exp(), format!("hit {:.4}", d2.sqrt()))
                             }
                             other => (0.0, format!("{other:?}")),
                         }
@@ -158,7 +160,7 @@ fn main() {
                         let (snx, sny) = sf.normal();
                         let perp = snx * ex + sny * ey;
                         let d = f.nearest(u, v, c * b.c - s * b.s, s * b.c + c * b.s).map_or(0.0, |x| x.1.sqrt());
-                        let w = (-d * d / params.sigma).exp();
+                        let w = (-d * d / params.matcher.sigma).exp();
                         let (tx, ty) = (-(v + oy - truth.y), u + ox - truth.x);
                         let torque =
                             if std::env::var("FX").is_ok() { w * perp * snx } else { w * perp * (snx * tx + sny * ty) };
@@ -196,7 +198,7 @@ fn main() {
                 };
                 let r = matcher.match_scan(&tm, &init, &ps, None, &mut scratch);
                 let (p, s) = (r.pose, r.score);
-                let st_truth = match matcher.kind {
+                let st_truth = match matcher.params.kind {
                     MatcherKind::Gmapping => matcher.score(&tm, &truth, &ps.matched),
                     MatcherKind::Field => matcher.field_eval(&scratch.field, &truth, &ps.matched).score,
                 };
@@ -263,9 +265,9 @@ fn main() {
         for b in &ps.hits {
             let (dx, dy) = (c * b.c - s * b.s, s * b.c + c * b.s);
             let (ex, ey) = (lp.x + b.r * dx, lp.y + b.r * dy);
-            if params.seen_band > 0.0 {
-                let r0 = (b.r - params.seen_band).max(0.0);
-                let band = params.seen_band;
+            if params.matcher.seen_band > 0.0 {
+                let r0 = (b.r - params.matcher.seen_band).max(0.0);
+                let band = params.matcher.seen_band;
                 tm.mark_seen(lp.x + r0 * dx, lp.y + r0 * dy, ex + band * dx, ey + band * dy).unwrap();
             }
             tm.add_beam_hit(ex, ey, dx, dy).unwrap();

@@ -188,7 +188,7 @@ fn main() {
         let s: Vec<String> = v.iter().map(|(r, l)| format!("{r:.3}@{l:.0}")).collect();
         println!("particles (rms@loglik, best first): {}", s.join(" "));
     }
-    if f.params().odometry_calibration > 0.0 {
+    if f.params().filter.odometry_calibration > 0.0 {
         let k = f.odometry_calibration();
         println!("odometry calibration: scale {:+.4} heading {:+.4} rad/m", k[0], k[1]);
     }

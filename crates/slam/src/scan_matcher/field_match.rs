@@ -4,6 +4,7 @@
 use super::{Beam, Evaluation, NULL_LIKELIHOOD, PosePrior, PreparedScan, ScanMatcher, Xyt, exp_neg};
 use crate::field::{Field, Lookup, Surfel};
 use crate::tile_map::TileMap;
+use mrslam_matching::Information;
 
 /// Metres around the scan's end points (at the starting pose) that the likelihood field covers beyond them:
 /// how far the optimiser may move an end point and still find the field.
@@ -28,7 +29,7 @@ impl ScanMatcher {
         // first angular steps turn the robot, widened by the margin. Sampled every margin along the arc, so
         // the discs cover a band about the arc rather than the disc around the end point a long beam's arc
         // spans (at 30 m, a band a metre wide instead of a disc 9 m across).
-        let turn = self.heading_search + 2.0 * self.astep;
+        let turn = self.params.heading_search + 2.0 * self.params.astep;
         let near = scan.hits.iter().flat_map(move |b| {
             let (ex, ey) = (lp.x + c * b.x - s * b.y - p.x, lp.y + s * b.x + c * b.y - p.y);
             let arm = ex.hypot(ey);
@@ -41,7 +42,7 @@ impl ScanMatcher {
         });
         let (a, b) = map.cell_of(x0 - FIELD_MARGIN, y0 - FIELD_MARGIN);
         let (c, d) = map.cell_of(x1 + FIELD_MARGIN, y1 + FIELD_MARGIN);
-        field.build_near(map, [a, b, c, d], self.field_reach, self.field_lines, near);
+        field.build_near(map, [a, b, c, d], self.params.field_reach, self.params.field_lines, near);
     }
 
     /// Score, log-likelihood and matched beams of robot pose `p` on a likelihood field.
@@ -51,8 +52,8 @@ impl ScanMatcher {
         let (s, c) = lp.theta.sin_cos();
         let (ox, oy) = f.origin();
         let (lx, ly) = (lp.x - ox, lp.y - oy);
-        let inv_sigma = 1.0 / self.sigma;
-        let inv_lsigma = 1.0 / self.lsigma;
+        let inv_sigma = 1.0 / self.params.sigma;
+        let inv_lsigma = 1.0 / self.params.lsigma;
         let unknown = self.unknown_score;
         let mut e = Evaluation::default();
         for b in beams {
@@ -76,7 +77,7 @@ impl ScanMatcher {
     /// steps towards the nearest maximum of the score.
     pub fn refine(&self, f: &Field, p: &Xyt, beams: &[Beam], prior: Option<&PosePrior>) -> Xyt {
         let mut p = *p;
-        for _ in 0..self.refine_iterations {
+        for _ in 0..self.params.refine_iterations {
             let (mut h, mut g) = self.normal_equations(f, &p, beams);
             if let Some(pr) = prior {
                 let d = pr.delta(&p);
@@ -103,21 +104,21 @@ impl ScanMatcher {
     /// [`ScanMatcher::refine`] without the prior (upper triangle 00 01 02 11 12 22, map frame), i.e. the
     /// curvature of the negated score in the units of `PosePrior::info`. Near zero in a direction the scan
     /// does not observe.
-    pub fn scan_information(&self, f: &Field, p: &Xyt, beams: &[Beam]) -> [f64; 6] {
+    pub fn scan_information(&self, f: &Field, p: &Xyt, beams: &[Beam]) -> Information {
         self.normal_equations(f, p, beams).0
     }
 
     /// The normal matrix (upper triangle) and gradient of the beams' weighted squared distances at `p`.
-    fn normal_equations(&self, f: &Field, p: &Xyt, beams: &[Beam]) -> ([f64; 6], [f64; 3]) {
+    fn normal_equations(&self, f: &Field, p: &Xyt, beams: &[Beam]) -> (Information, [f64; 3]) {
         let (ox, oy) = f.origin();
-        let inv_sigma = 1.0 / self.sigma;
+        let inv_sigma = 1.0 / self.params.sigma;
         // residuals in metres with the kernel's variance sigma/2: weights w·2/sigma in chi-square units
         let scale = 2.0 * inv_sigma;
         let lp = self.laser_pose(p);
         let (s, c) = lp.theta.sin_cos();
         let (lx, ly) = (lp.x - ox, lp.y - oy);
         let (rx, ry) = (p.x - ox, p.y - oy);
-        let mut h = [0.0f64; 6]; // upper triangle of the 3x3 normal matrix: 00 01 02 11 12 22
+        let mut h = Information::ZERO; // the 3x3 normal matrix
         let mut g = [0.0f64; 3];
         let mut add = |j: [f64; 3], r: f64, w: f64| {
             let w = w * scale;
@@ -158,9 +159,9 @@ impl ScanMatcher {
     }
 }
 
-/// Solves the symmetric 3x3 system H·x = g (H given as its upper triangle 00 01 02 11 12 22); None when
+/// Solves the symmetric 3x3 system H·x = g; None when
 /// H is (nearly) singular.
-fn solve3(h: &[f64; 6], g: &[f64; 3]) -> Option<[f64; 3]> {
+fn solve3(h: &Information, g: &[f64; 3]) -> Option<[f64; 3]> {
     let (a, b, c, d, e, f) = (h[0], h[1], h[2], h[3], h[4], h[5]);
     // cofactors
     let c00 = d * f - e * e;

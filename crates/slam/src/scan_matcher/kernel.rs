@@ -14,7 +14,7 @@ impl ScanMatcher {
     #[inline]
     fn nearest(&self, map: &TileMap, px: f64, py: f64, dx: f64, dy: f64) -> Option<f64> {
         let (ix, iy) = map.cell_of(px, py);
-        let k = self.kernel_size;
+        let k = self.params.kernel_size;
         let fx = if dx > FREE_STEP_THRESHOLD {
             -1
         } else if dx < -FREE_STEP_THRESHOLD {
@@ -70,7 +70,7 @@ impl ScanMatcher {
     pub fn score(&self, map: &TileMap, p: &Xyt, beams: &[Beam]) -> f64 {
         let lp = self.laser_pose(p);
         let (s, c) = lp.theta.sin_cos();
-        let inv_sigma = 1.0 / self.sigma;
+        let inv_sigma = 1.0 / self.params.sigma;
         let mut total = 0.0;
         for b in beams {
             let dx = c * b.c - s * b.s;
@@ -92,7 +92,7 @@ impl ScanMatcher {
     pub fn likelihood_and_score(&self, map: &TileMap, p: &Xyt, beams: &[Beam]) -> Evaluation {
         let lp = self.laser_pose(p);
         let (s, c) = lp.theta.sin_cos();
-        let no_hit = NULL_LIKELIHOOD / self.lsigma;
+        let no_hit = NULL_LIKELIHOOD / self.params.lsigma;
         let mut e = Evaluation::default();
         for b in beams {
             let dx = c * b.c - s * b.s;
@@ -100,8 +100,8 @@ impl ScanMatcher {
             let (px, py) = (lp.x + b.r * dx, lp.y + b.r * dy);
             match self.nearest(map, px, py, dx, dy) {
                 Some(d2) => {
-                    e.score += (-d2 / self.sigma).exp();
-                    e.likelihood += -d2 / self.lsigma;
+                    e.score += (-d2 / self.params.sigma).exp();
+                    e.likelihood += -d2 / self.params.lsigma;
                     e.matched += 1;
                 }
                 None => {

@@ -22,11 +22,14 @@
 
 mod field_match;
 mod kernel;
+mod params;
+
+pub use params::{MatcherKind, MatcherParams};
 
 use crate::field::Field;
-use crate::params::SlamParams;
 use crate::tile_map::TileMap;
 use mrslam_core::{LaserScan, Xyt};
+use mrslam_matching::Information;
 
 /// GMapping's `nullLikelihood`: a beam that matches nothing costs `-0.5/lsigma`.
 const NULL_LIKELIHOOD: f64 = -0.5;
@@ -35,38 +38,6 @@ const NULL_LIKELIHOOD: f64 = -0.5;
 const SWEEP_STRIDE: usize = 4;
 /// The `field` matcher's hill climb scores every this-many-th matched beam.
 const CLIMB_STRIDE: usize = 2;
-
-/// Which scan matcher scores poses.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum MatcherKind {
-    /// GMapping's: per beam and pose, a (2k+1)² kernel search for the nearest cell mean with a free cell
-    /// behind it; hill climbing.
-    #[default]
-    Gmapping,
-    /// A likelihood field of surfels built once per particle and update (`field`): one table read
-    /// per beam; hill climbing on it, then Gauss-Newton refinement (`refine_iterations`).
-    Field,
-}
-
-impl std::str::FromStr for MatcherKind {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        match s.trim() {
-            "gmapping" => Ok(MatcherKind::Gmapping),
-            "field" => Ok(MatcherKind::Field),
-            other => Err(format!("unknown matcher '{other}' (expected gmapping or field)")),
-        }
-    }
-}
-
-impl std::fmt::Display for MatcherKind {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(match self {
-            MatcherKind::Gmapping => "gmapping",
-            MatcherKind::Field => "field",
-        })
-    }
-}
 
 /// One beam in the laser frame: range, unit direction and end point.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -104,7 +75,7 @@ pub struct PreparedScan {
 }
 
 impl PreparedScan {
-    /// Sorts a scan's beams. `max_range` and `max_urange` as in [`crate::SlamParams`].
+    /// Sorts a scan's beams. `max_range` and `max_urange` as in [`crate::MapParams`].
     pub fn new(scan: &LaserScan, max_range: f64, max_urange: f64, lskip: usize) -> Self {
         let mut out = PreparedScan::default();
         for i in 0..scan.len() {
@@ -130,52 +101,19 @@ impl PreparedScan {
     }
 }
 
-/// The scan matcher's settings (see [`crate::SlamParams`] for each).
+/// A scan matcher: its parameters and the laser mount it matches from.
 #[derive(Debug, Clone, Copy, PartialEq)]
 /// Public (through the crate's `dev` module) only for the tests, benches and development probes.
 pub struct ScanMatcher {
     /// Laser mount pose on the robot.
     pub laser: Xyt,
-    /// Score sigma.
-    pub sigma: f64,
-    /// Likelihood sigma.
-    pub lsigma: f64,
-    /// Search window half-width, cells.
-    pub kernel_size: i32,
-    /// Initial linear step, metres.
-    pub lstep: f64,
-    /// Initial angular step, radians.
-    pub astep: f64,
-    /// Step halvings.
-    pub iterations: u32,
+    /// The matcher's parameters.
+    pub params: MatcherParams,
     /// Score of a beam ending unmatched in never-seen space; `None`: 0, as GMapping (see
-    /// [`crate::SlamParams::seen_band`]).
+    /// [`MatcherParams::seen_band`]).
     pub unknown_score: Option<f64>,
-    /// Which matcher.
-    pub kind: MatcherKind,
-    /// `field` matcher: reach of the likelihood field, cells.
-    pub field_reach: i32,
-    /// `field` matcher: measure to surface segments (true) or to cell means (false).
-    pub field_lines: bool,
-    /// `field` matcher: Gauss-Newton iterations after the hill climb.
-    pub refine_iterations: u32,
-    /// Weigh particles with every beam (true) or the matched (every lskip+1-th) beams only (false).
-    pub weight_all_beams: bool,
-    /// `field` matcher: half-width of the correlative heading search before the climb, radians (0: off).
-    pub heading_search: f64,
-    /// `field` matcher: step of the heading search, radians.
-    pub heading_step: f64,
-    /// `field` matcher: weight of the motion-model prior (0: none; see `MotionPrior`).
-    pub motion_prior: f64,
-    /// The matched pose replaces the starting pose only when its score exceeds this.
-    pub minimum_score: f64,
-    /// GMapping matcher: match only the beams that find a cell at the starting pose (see
-    /// [`ScanMatcher::beams_in_map`]).
-    pub frontier_guard: bool,
-    /// `field` matcher: weigh by GMapping's kernel likelihood at the matched pose instead of the field's.
-    pub kernel_likelihood: bool,
     /// `field` matcher: report the scan's and the prior's information at the matched pose
-    /// (`MatchResult::information`; set for [`crate::SlamParams::odometry_calibration`]).
+    /// (`MatchResult::information`; set for [`crate::FilterParams::odometry_calibration`]).
     pub information: bool,
 }
 
@@ -195,20 +133,26 @@ pub struct MotionPrior {
 }
 
 impl MotionPrior {
-    /// The information matrix (upper triangle 00 01 02 11 12 22) in the map frame for a robot at heading
-    /// `t`, scaled by `weight`.
-    fn information(&self, t: f64, weight: f64) -> [f64; 6] {
+    /// The information matrix in the map frame for a robot at heading `t`, scaled by `weight`.
+    fn information(&self, t: f64, weight: f64) -> Information {
         let (s, c) = t.sin_cos();
         let (ix, iy) = (weight / (self.sx * self.sx), weight / (self.sy * self.sy));
-        [c * c * ix + s * s * iy, c * s * (ix - iy), 0.0, s * s * ix + c * c * iy, 0.0, weight / (self.st * self.st)]
+        Information([
+            c * c * ix + s * s * iy,
+            c * s * (ix - iy),
+            0.0,
+            s * s * ix + c * c * iy,
+            0.0,
+            weight / (self.st * self.st),
+        ])
     }
 }
 
-/// A Gaussian prior on the pose: information matrix (map frame, upper triangle 00 01 02 11 12 22) and centre.
+/// A Gaussian prior on the pose: information matrix (map frame) and centre.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PosePrior {
     /// Information matrix.
-    pub info: [f64; 6],
+    pub info: Information,
     /// Centre (the prior's mean).
     pub centre: Xyt,
 }
@@ -255,9 +199,17 @@ pub struct MatchResult {
     /// Beams of the likelihood that found a surface at `pose`.
     pub matched: usize,
     /// `field` matcher with [`ScanMatcher::information`] on: the scan's information about the pose at `pose`
-    /// ([`ScanMatcher::scan_information`]) and the motion prior's (zero without one), map frame, upper
-    /// triangles 00 01 02 11 12 22.
-    pub information: Option<([f64; 6], [f64; 6])>,
+    /// ([`ScanMatcher::scan_information`]) and the motion prior's (zero without one), map frame.
+    pub information: Option<MatchInformation>,
+}
+
+/// The information about a matched pose (map frame): the scan's and the motion prior's.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MatchInformation {
+    /// The scan's ([`ScanMatcher::scan_information`]).
+    pub scan: Information,
+    /// The motion prior's (zero without one).
+    pub prior: Information,
 }
 
 /// Result of evaluating a pose: score, log-likelihood and the number of beams that matched.
@@ -293,29 +245,14 @@ pub fn exp_neg(t: f64) -> f64 {
 }
 
 impl ScanMatcher {
-    /// The matcher configured by `params`, for a laser mounted at `laser` on the robot.
-    pub fn from_params(params: &SlamParams, laser: Xyt) -> Self {
+    /// The matcher `params` configure, for a laser mounted at `laser` on the robot; with `information`, the
+    /// `field` matcher reports the information at each match.
+    pub fn new(params: MatcherParams, laser: Xyt, information: bool) -> Self {
         ScanMatcher {
             laser,
-            sigma: params.sigma,
-            lsigma: params.lsigma,
-            kernel_size: params.kernel_size,
-            lstep: params.lstep,
-            astep: params.astep,
-            iterations: params.iterations,
+            params,
             unknown_score: (params.seen_band > 0.0).then_some(params.unknown_score),
-            kind: params.matcher,
-            field_reach: params.field_reach,
-            field_lines: params.field_lines,
-            refine_iterations: params.refine_iterations,
-            weight_all_beams: params.weight_all_beams,
-            heading_search: params.heading_search,
-            heading_step: params.heading_step,
-            motion_prior: params.motion_prior,
-            minimum_score: params.minimum_score,
-            frontier_guard: params.frontier_guard,
-            kernel_likelihood: params.kernel_likelihood,
-            information: params.odometry_calibration > 0.0 && params.matcher == MatcherKind::Field,
+            information: information && params.kind == MatcherKind::Field,
         }
     }
 
@@ -329,16 +266,16 @@ impl ScanMatcher {
         prior: Option<&MotionPrior>,
         scratch: &mut Scratch,
     ) -> MatchResult {
-        let weigh = if self.weight_all_beams { &scan.hits } else { &scan.matched };
-        match self.kind {
+        let weigh = if self.params.weight_all_beams { &scan.hits } else { &scan.matched };
+        match self.params.kind {
             MatcherKind::Gmapping => {
-                let (corrected, score) = if self.frontier_guard {
+                let (corrected, score) = if self.params.frontier_guard {
                     let guarded = self.beams_in_map(map, init, &scan.matched);
                     self.optimize(map, init, &guarded)
                 } else {
                     self.optimize(map, init, &scan.matched)
                 };
-                let accepted = score > self.minimum_score;
+                let accepted = score > self.params.minimum_score;
                 let pose = if accepted { corrected } else { *init };
                 let e = self.likelihood_and_score(map, &pose, weigh);
                 MatchResult { pose, score, likelihood: e.likelihood, accepted, matched: e.matched, information: None }
@@ -347,8 +284,8 @@ impl ScanMatcher {
                 self.build_field(map, init, scan, &mut scratch.field);
                 let f = &scratch.field;
                 let prior = prior
-                    .filter(|_| self.motion_prior > 0.0)
-                    .map(|m| PosePrior { info: m.information(init.theta, self.motion_prior), centre: *init });
+                    .filter(|_| self.params.motion_prior > 0.0)
+                    .map(|m| PosePrior { info: m.information(init.theta, self.params.motion_prior), centre: *init });
                 let penalty = |q: &Xyt| prior.as_ref().map_or(0.0, |p| p.penalty(q));
                 let objective = |q: &Xyt| self.field_eval(f, q, &scan.matched).score - penalty(q);
                 // The heading search and the climb only pick the basin and approach its optimum, which the
@@ -358,7 +295,7 @@ impl ScanMatcher {
                 let coarse: Vec<Beam> = scan.matched.iter().step_by(CLIMB_STRIDE).copied().collect();
                 let (mut best, _) = self.climb(&start, |q| self.field_eval(f, q, &coarse).score - penalty(q));
                 let mut score = objective(&best);
-                if self.refine_iterations > 0 {
+                if self.params.refine_iterations > 0 {
                     let r = self.refine(f, &best, &scan.matched, prior.as_ref());
                     let sr = self.field_eval(f, &r, &scan.matched).score - penalty(&r);
                     if sr > score {
@@ -366,15 +303,16 @@ impl ScanMatcher {
                         score = sr;
                     }
                 }
-                let accepted = score > self.minimum_score;
+                let accepted = score > self.params.minimum_score;
                 let pose = if accepted { best } else { *init };
-                let e = if self.kernel_likelihood {
+                let e = if self.params.kernel_likelihood {
                     self.likelihood_and_score(map, &pose, weigh)
                 } else {
                     self.field_eval(f, &pose, weigh)
                 };
-                let information = self.information.then(|| {
-                    (self.scan_information(f, &pose, &scan.matched), prior.as_ref().map_or([0.0; 6], |p| p.info))
+                let information = self.information.then(|| MatchInformation {
+                    scan: self.scan_information(f, &pose, &scan.matched),
+                    prior: prior.as_ref().map_or(Information::ZERO, |p| p.info),
                 });
                 MatchResult { pose, score, likelihood: e.likelihood, accepted, matched: e.matched, information }
             }
@@ -395,14 +333,14 @@ impl ScanMatcher {
     /// The correlative heading search: scores `init` turned by every multiple of `heading_step` within
     /// ±`heading_search` and returns the best (the smallest turn on ties); `init` when the search is off.
     pub fn sweep_heading(&self, init: &Xyt, score: impl Fn(&Xyt) -> f64) -> Xyt {
-        if !(self.heading_search > 0.0 && self.heading_step > 0.0) {
+        if !(self.params.heading_search > 0.0 && self.params.heading_step > 0.0) {
             return *init;
         }
-        let k = (self.heading_search / self.heading_step).floor() as i32;
+        let k = (self.params.heading_search / self.params.heading_step).floor() as i32;
         let mut best = (score(init), *init);
         for i in 1..=k {
             for sign in [-1.0, 1.0] {
-                let q = Xyt { theta: init.theta + sign * i as f64 * self.heading_step, ..*init };
+                let q = Xyt { theta: init.theta + sign * i as f64 * self.params.heading_step, ..*init };
                 let s = score(&q);
                 if s > best.0 {
                     best = (s, q);
@@ -419,7 +357,7 @@ impl ScanMatcher {
         let mut best_score = -1.0;
         let mut current = *init;
         let mut current_score = score(&current);
-        let (mut ldelta, mut adelta) = (self.lstep, self.astep);
+        let (mut ldelta, mut adelta) = (self.params.lstep, self.params.astep);
         let mut refinement = 0;
         // Bounded like GMapping's loop is in practice: each round improves the score or halves the steps.
         let mut rounds = 0;
@@ -449,7 +387,7 @@ impl ScanMatcher {
             }
             current = best_local;
             rounds += 1;
-            if !(current_score > best_score || refinement < self.iterations) || rounds > 1000 {
+            if !(current_score > best_score || refinement < self.params.iterations) || rounds > 1000 {
                 break;
             }
         }
@@ -462,28 +400,7 @@ mod tests {
     use super::*;
 
     fn matcher() -> ScanMatcher {
-        ScanMatcher {
-            laser: Xyt { x: 0.0, y: 0.0, theta: 0.0 },
-            sigma: 0.05,
-            lsigma: 0.075,
-            kernel_size: 1,
-            lstep: 0.05,
-            astep: 0.05,
-            iterations: 5,
-            unknown_score: None,
-            kind: MatcherKind::Gmapping,
-            field_reach: 3,
-            field_lines: true,
-            refine_iterations: 0,
-            weight_all_beams: false,
-            heading_search: 0.0,
-            heading_step: 0.01,
-            motion_prior: 0.0,
-            minimum_score: 0.0,
-            frontier_guard: false,
-            kernel_likelihood: false,
-            information: false,
-        }
+        ScanMatcher::new(MatcherParams::default(), Xyt { x: 0.0, y: 0.0, theta: 0.0 }, false)
     }
 
     /// A square room 4 m across around the origin, mapped as hits from the true pose.
@@ -567,11 +484,12 @@ mod tests {
         // GMapping's hill climber has a narrow basin (its first steps are 5 cm and 0.05 rad) and stops at a
         // few centimetres; the matched preset's field matcher searches ±0.05 rad and refines to the optimum.
         // Headings are spread by 0.03 rad, what the motion model adds over a metre of matched odometry.
-        for (params, spread, turn, shrink, bound) in
-            [(SlamParams::default(), 0.03, 0.03, 2.0, 0.025), (SlamParams::matched(), 0.1, 0.03, 4.0, 0.03)]
-        {
-            let m = ScanMatcher::from_params(&params, Xyt { x: 0.0, y: 0.0, theta: 0.0 });
-            let mut map = TileMap::new(params.delta);
+        for (params, spread, turn, shrink, bound) in [
+            (MatcherParams::default(), 0.03, 0.03, 2.0, 0.025),
+            (crate::SlamParams::matched().matcher, 0.1, 0.03, 4.0, 0.03),
+        ] {
+            let m = ScanMatcher::new(params, Xyt { x: 0.0, y: 0.0, theta: 0.0 }, false);
+            let mut map = TileMap::new(0.05);
             for k in 0..10 {
                 let p = at(3.0 + 0.5 * k as f64);
                 let scan = PreparedScan::new(&lidar.scan(&office, &p, 0.0, &mut rng), 20.0, 20.0, 0);
@@ -606,7 +524,7 @@ mod tests {
             assert!(
                 after <= bound && after * shrink <= before && heading <= 0.5f64.to_radians(),
                 "{:?}: samples {before} m from the truth, proposal {after} m and {heading} rad",
-                params.matcher
+                params.kind
             );
         }
     }

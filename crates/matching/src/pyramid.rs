@@ -4,7 +4,7 @@
 //! [y, y + 2^k)` (0 for cells off the field). Summed over a scan's points displaced by an offset, it bounds
 //! from above the score of every offset in the `2^k × 2^k` block that offset starts.
 
-use super::field::ScoreField;
+use crate::field::ScoreField;
 
 /// One level: cells `x ∈ [-(2^k - 1), width)`, same for y, stored from the lowest.
 #[derive(Debug, Clone)]

@@ -1,7 +1,7 @@
 //! Map b's walls as a point set: occupied cells (or blocks) in b's map frame, thinned evenly, about their
 //! centroid, and their cell offsets once rotated.
 
-use super::field::BlockStates;
+use crate::field::BlockStates;
 use mrslam_core::{CellState, OccupancyGrid};
 use nalgebra::{Point2, Rotation2, Vector2};
 

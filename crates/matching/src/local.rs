@@ -6,8 +6,8 @@
 //! compiler vectorises. On a field blurred over a few cells a max-pooled bound stays above most offsets' scores
 //! and branch and bound scores nearly all of them anyway, one gather per point each (8x slower on real maps).
 
-use super::field::ScoreField;
-use super::scan::WallScan;
+use crate::field::ScoreField;
+use crate::scan::WallScan;
 
 /// A score field laid out for window searches: each row with zero cells either side, so a window's row segment
 /// that leaves the field reads zeros, as a point off the field scores.

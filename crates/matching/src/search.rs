@@ -5,7 +5,7 @@
 //! block); blocks are split into four, best first, and a branch is dropped as soon as its bound cannot beat
 //! the weakest of the answers kept. The leaves are exact scores on the field itself.
 
-use super::pyramid::Pyramid;
+use crate::pyramid::Pyramid;
 
 /// An offset and its score.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -135,8 +135,8 @@ fn descend(pyramid: &Pyramid, points: &[(i32, i32)], window: Window, k: usize, c
 
 #[cfg(test)]
 mod tests {
-    use super::super::field::ScoreField;
     use super::*;
+    use crate::field::ScoreField;
     use rand::{Rng, SeedableRng};
     use rand_chacha::ChaCha8Rng;
 

@@ -8,6 +8,7 @@
 //! Cholesky factorisation (`nalgebra-sparse`); in time order the factor fills only within each loop edge's
 //! span, so no reordering is needed at the sizes of a log (a node per metre driven).
 
+use crate::Information;
 use mrslam_core::Xyt;
 use mrslam_core::pose::normalize_angle;
 use nalgebra::{DVector, Matrix3, Vector3};
@@ -25,7 +26,7 @@ pub struct Edge {
     pub measured: Xyt,
     /// Information matrix of the error (upper triangle 00 01 02 11 12 22): translation in the frame of
     /// `from ⊕ measured` (i.e. `to`'s own frame), then heading.
-    pub information: [f64; 6],
+    pub information: Information,
     /// Huber's threshold on the edge's Mahalanobis distance √(eᵀ Ω e); infinite for plain least squares.
     pub huber: f64,
 }
@@ -69,17 +70,6 @@ fn linearize(e: &Edge, poses: &[Xyt]) -> ([f64; 3], [[f64; 3]; 3], [[f64; 3]; 3]
     ([ex, ey, et], ji, jj)
 }
 
-/// The symmetric 3x3 matrix of an upper triangle.
-fn full(h: &[f64; 6]) -> Matrix3<f64> {
-    Matrix3::new(h[0], h[1], h[2], h[1], h[3], h[4], h[2], h[4], h[5])
-}
-
-/// eᵀ Ω e.
-pub fn mahalanobis2(err: &[f64; 3], info: &[f64; 6]) -> f64 {
-    let e = Vector3::from(*err);
-    e.dot(&(full(info) * e))
-}
-
 /// Huber's ρ of a squared distance `d2` with threshold `k`, and its weight ρ'(d2).
 fn huber(d2: f64, k: f64) -> (f64, f64) {
     let d = d2.sqrt();
@@ -88,7 +78,7 @@ fn huber(d2: f64, k: f64) -> (f64, f64) {
 
 /// Σ ρ(eᵀ Ω e).
 pub fn cost(poses: &[Xyt], edges: &[Edge]) -> f64 {
-    edges.iter().map(|e| huber(mahalanobis2(&linearize(e, poses).0, &e.information), e.huber).0).sum()
+    edges.iter().map(|e| huber(e.information.mahalanobis2(&linearize(e, poses).0), e.huber).0).sum()
 }
 
 /// Optimises `poses` (node 0 fixed) for `edges` by at most `max_iterations` Gauss-Newton steps, each
@@ -113,8 +103,8 @@ pub fn optimize(poses: &mut [Xyt], edges: &[Edge], max_iterations: u32) -> Optio
         let mut diag = vec![0.0f64; dim];
         for e in edges {
             let (err, ji, jj) = linearize(e, &current);
-            let (_, w) = huber(mahalanobis2(&err, &e.information), e.huber);
-            let o = full(&e.information);
+            let (_, w) = huber(e.information.mahalanobis2(&err), e.huber);
+            let o = e.information.matrix();
             let err = Vector3::from(err);
             let blocks = [(e.from, Matrix3::from(ji).transpose()), (e.to, Matrix3::from(jj).transpose())];
             for &(na, ja) in &blocks {
@@ -178,7 +168,7 @@ mod tests {
         Xyt::from_pose(&relative(&a.to_pose(), &b.to_pose()))
     }
 
-    const INFO: [f64; 6] = [100.0, 0.0, 0.0, 100.0, 0.0, 400.0];
+    const INFO: Information = Information([100.0, 0.0, 0.0, 100.0, 0.0, 400.0]);
 
     /// A square loop of 4 m sides, a node every metre, ending where it started.
     fn square() -> Vec<Xyt> {
@@ -236,7 +226,7 @@ mod tests {
         assert!(before > 0.5, "the chain drifted {before} m");
         // The loop edge: the last node seen from the first, as it truly is, stiffer than the chain.
         let z = between(&truth[0], &truth[last]);
-        let stiff = [1e4, 0.0, 0.0, 1e4, 0.0, 1e4];
+        let stiff = Information([1e4, 0.0, 0.0, 1e4, 0.0, 1e4]);
         edges.push(Edge { from: 0, to: last, measured: z, information: stiff, huber: 3.0 });
         let mut poses = drifted.clone();
         let s = optimize(&mut poses, &edges, 50).unwrap();
@@ -252,7 +242,7 @@ mod tests {
     #[test]
     fn a_wrong_loop_edge_under_huber_moves_the_chain_far_less_than_under_least_squares() {
         let truth = square();
-        let stiff = [1e4, 0.0, 0.0, 1e4, 0.0, 1e4];
+        let stiff = Information([1e4, 0.0, 0.0, 1e4, 0.0, 1e4]);
         let mut edges: Vec<Edge> = (1..truth.len())
             .map(|k| Edge {
                 from: k - 1,
