@@ -14,6 +14,10 @@
 //! `loop_closure` on, [`map_log`] first smooths that trajectory ([`Rbpf::close_loops`]: `loop_closure` finds
 //! loop edges, `pose_graph` optimises).
 //!
+//! [`SlamBackend`] is what code that feeds a SLAM needs of it (process a reading, the map, the best pose, the
+//! trajectory, loop-closure corrections, the pose hypotheses for display); [`Rbpf`] implements it, and
+//! [`map_log`] and the testbed drive any implementation.
+//!
 //! Modules are private: the items below are the API; [`synthetic`] (test data) is a public namespace and
 //! [`dev`] holds internals public only for the development probes (`dev/` in the repository).
 //!
@@ -38,6 +42,7 @@
 
 #![deny(missing_docs)]
 
+mod backend;
 mod calibration;
 mod error;
 mod every_scan;
@@ -45,6 +50,7 @@ mod field;
 mod loop_closure;
 mod map_build;
 mod motion;
+mod outcome;
 mod params;
 mod particle;
 mod pose_graph;
@@ -55,11 +61,13 @@ mod scan_odometry;
 pub mod synthetic;
 mod tile_map;
 
+pub use backend::{Correction, Hypotheses, SlamBackend};
 pub use error::SlamError;
 pub use every_scan::{LogRun, LogRunError, map_log, poses_at_every_scan};
 pub use loop_closure::LoopClosureReport;
+pub use outcome::{Counters, SkipReason, UpdateOutcome, UpdateStats};
 pub use params::{MatcherKind, Preset, SlamParams};
-pub use rbpf::{Counters, MemoryStats, Rbpf, SkipReason, UpdateOutcome, UpdateStats};
+pub use rbpf::{MemoryStats, Rbpf};
 
 /// Internals public only for the development probes (`dev/src/bin/matcher_lab.rs`, `matcher_check.rs`): the
 /// scan matcher on a hand-built tile map. Not part of the crate's API; the filter ([`Rbpf`]) is.
