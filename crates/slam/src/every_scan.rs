@@ -8,7 +8,10 @@
 //! Scans before the first processed scan are placed by odometry back from it, scans after the last by
 //! odometry from it.
 
-use crate::{LoopClosureReport, Rbpf, SlamError, UpdateOutcome};
+use crate::backend::SlamBackend;
+use crate::error::SlamError;
+use crate::loop_closure::LoopClosureReport;
+use crate::outcome::UpdateOutcome;
 use mrslam_core::pose::interpolate;
 use mrslam_core::{LaserScan, Odometry, Pose2};
 
@@ -19,7 +22,8 @@ pub struct LogRun {
     pub poses: Vec<Pose2>,
     /// Indices of the scans the filter processed.
     pub processed: Vec<usize>,
-    /// What loop closure did (`None` when [`crate::SlamParams::loop_closure`] is off).
+    /// What loop closure did (`None` when the back-end did none: for the particle filter, when
+    /// [`crate::SlamParams::loop_closure`] is off).
     pub loop_closure: Option<LoopClosureReport>,
 }
 
@@ -39,15 +43,18 @@ pub enum LogRunError {
     NothingProcessed,
 }
 
-/// Feeds `filter` a log's readings (each scan with its odometry, in order) and places every scan: the filter's
-/// pose at the processed ones, its odometry (scan-matched when `scan_odometry` is on) in between.
-/// `on_reading` sees each reading's outcome and the filter after it (for progress, or to watch the filter);
-/// with `loop_closure` on, the trajectory is then smoothed ([`Rbpf::close_loops`]). The map is the filter's
-/// afterwards.
-pub fn map_log<'a>(
-    filter: &mut Rbpf,
+/// Feeds `filter` (any [`SlamBackend`]) a log's readings (each scan with its odometry, in order) and places every
+/// scan: the back-end's pose at the processed ones, its odometry (scan-matched when `scan_odometry` is on) in
+/// between. `on_reading` sees each reading's outcome and the back-end after it (for progress, or to watch it);
+/// then [`SlamBackend::finish`] ends the data (the particle filter smooths its trajectory when `loop_closure` is
+/// on, [`crate::Rbpf::close_loops`]). The map is the back-end's afterwards.
+///
+/// Generic rather than over `dyn SlamBackend`: the caller's `on_reading` sees its own back-end type (the CLI
+/// reads the particle filter's own statistics there); `B = dyn SlamBackend` works too.
+pub fn map_log<'a, B: SlamBackend + ?Sized>(
+    filter: &mut B,
     readings: impl IntoIterator<Item = (&'a Odometry, &'a LaserScan)>,
-    mut on_reading: impl FnMut(&UpdateOutcome, &Rbpf),
+    mut on_reading: impl FnMut(&UpdateOutcome, &B),
 ) -> Result<LogRun, LogRunError> {
     let mut processed = Vec::new();
     let mut odometry = Vec::new();
@@ -61,7 +68,7 @@ pub fn map_log<'a>(
         }
         on_reading(&out, filter);
     }
-    let loop_closure = filter.params().loop_closure.enabled.then(|| filter.close_loops());
+    let loop_closure = filter.finish();
     let keyframes = filter.trajectory();
     debug_assert_eq!(keyframes.len(), processed.len(), "one trajectory node per processed scan");
     let anchors: Vec<(usize, Pose2)> = processed.iter().copied().zip(keyframes.into_iter().map(|(_, p)| p)).collect();

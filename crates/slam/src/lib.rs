@@ -14,6 +14,10 @@
 //! `loop_closure` on, [`map_log`] first smooths that trajectory ([`Rbpf::close_loops`]: `loop_closure` finds
 //! loop edges, `mrslam_matching::pose_graph` optimises).
 //!
+//! [`SlamBackend`] is what code that feeds a SLAM needs of it (process a reading, the map, the best pose, the
+//! trajectory, loop-closure corrections, the pose hypotheses for display); [`Rbpf`] implements it, and
+//! [`map_log`] and the testbed drive any implementation.
+//!
 //! Modules are private: the items below are the API; [`synthetic`] (test data) is a public namespace and
 //! [`dev`] holds internals public only for the development probes (`dev/` in the repository).
 //!
@@ -38,6 +42,7 @@
 
 #![deny(missing_docs)]
 
+mod backend;
 mod calibration;
 mod error;
 mod every_scan;
@@ -45,6 +50,7 @@ mod field;
 mod loop_closure;
 mod map_build;
 mod motion;
+mod outcome;
 mod params;
 mod particle;
 mod rbpf;
@@ -54,13 +60,15 @@ mod scan_odometry;
 pub mod synthetic;
 mod tile_map;
 
+pub use backend::{Correction, Hypotheses, SlamBackend};
 pub use error::SlamError;
 pub use every_scan::{LogRun, LogRunError, map_log, poses_at_every_scan};
 pub use loop_closure::{LoopClosureParams, LoopClosureReport};
 pub use map_build::MapParams;
 pub use motion::MotionModel;
+pub use outcome::{Counters, SkipReason, UpdateOutcome, UpdateStats};
 pub use params::{FLAT_NAMES, FilterParams, ParamError, Preset, SlamParams};
-pub use rbpf::{Counters, MemoryStats, Rbpf, SkipReason, UpdateOutcome, UpdateStats};
+pub use rbpf::{MemoryStats, Rbpf};
 pub use scan_matcher::{MatcherKind, MatcherParams};
 pub use scan_odometry::ScanOdometryParams;
 

@@ -1,10 +1,12 @@
 //! The filter: GMapping's `GridSlamProcessor::processScan` loop over odometry + scans.
 
+use crate::backend::{Correction, Hypotheses, SlamBackend};
 use crate::calibration::{CalibrationMatch, OdometryCalibration};
 use crate::error::SlamError;
 use crate::loop_closure::LoopClosureReport;
 use crate::map_build::build_map;
 use crate::motion::MotionModel;
+use crate::outcome::{Counters, SkipReason, UpdateOutcome, UpdateStats};
 use crate::params::SlamParams;
 use crate::particle::{Particle, TrajectoryNode, ancestry};
 use crate::resample::{normalize, systematic};
@@ -32,81 +34,6 @@ thread_local! {
     /// fifth of the CPU time. The field is rebuilt for every match, so results do not depend on which
     /// scratch a particle gets (see [`crate::field`]).
     static SCRATCH: RefCell<Scratch> = RefCell::new(Scratch::default());
-}
-
-/// Why a scan was not processed.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum SkipReason {
-    /// The robot has not moved (or waited) enough since the last processed scan; its odometry still moved
-    /// the particles.
-    NotMoved,
-    /// The scan has no beams; its odometry still moved the particles.
-    EmptyScan,
-}
-
-/// Statistics of one processed scan.
-#[derive(Debug, Clone, PartialEq)]
-pub struct UpdateStats {
-    /// Neff of the weights computed at this update (the value the resampling decision was made on).
-    pub neff: f64,
-    /// Whether the particles were resampled.
-    pub resampled: bool,
-    /// Particles whose scan-matched pose replaced the motion-model pose (score > minimum_score).
-    pub matched_particles: usize,
-    /// Mean matcher score over particles.
-    pub mean_score: f64,
-    /// Beams the matcher used.
-    pub beams_matched: usize,
-    /// Beams recorded as hits.
-    pub beams_mapped: usize,
-    /// Beams ignored as invalid (NaN, negative, below the sensor's minimum range).
-    pub invalid_beams: usize,
-    /// Index of the best particle after the update.
-    pub best: usize,
-}
-
-/// What [`Rbpf::process`] did with a reading.
-#[derive(Debug, Clone, PartialEq)]
-pub enum UpdateOutcome {
-    /// The scan was matched and mapped.
-    Processed(UpdateStats),
-    /// The scan was not processed (odometry still applied).
-    Skipped(SkipReason),
-}
-
-impl UpdateOutcome {
-    /// True when the scan was processed.
-    pub fn is_processed(&self) -> bool {
-        matches!(self, UpdateOutcome::Processed(_))
-    }
-    /// Neff of the update, when processed.
-    pub fn neff(&self) -> Option<f64> {
-        match self {
-            UpdateOutcome::Processed(s) => Some(s.neff),
-            UpdateOutcome::Skipped(_) => None,
-        }
-    }
-    /// True when the update resampled.
-    pub fn resampled(&self) -> bool {
-        matches!(self, UpdateOutcome::Processed(s) if s.resampled)
-    }
-}
-
-/// Running totals over all readings.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub struct Counters {
-    /// Readings given to [`Rbpf::process`] and accepted.
-    pub readings: usize,
-    /// Scans processed.
-    pub processed: usize,
-    /// Scans skipped because the robot had not moved enough.
-    pub skipped_not_moved: usize,
-    /// Scans skipped because they had no beams.
-    pub skipped_empty: usize,
-    /// Beams ignored as invalid (NaN, negative, below range_min), over all readings.
-    pub invalid_beams: usize,
-    /// Resampling steps.
-    pub resamples: usize,
 }
 
 /// Memory held by the particles' maps and trajectories.
@@ -164,6 +91,8 @@ pub struct Rbpf {
     /// Scan-matched odometry (see [`SlamParams::scan_odometry`]).
     scan_odometry: Option<ScanOdometry>,
     counters: Counters,
+    /// Trajectory poses moved by [`Rbpf::close_loops`], not yet taken ([`SlamBackend::take_corrections`]).
+    corrections: Vec<Correction>,
 }
 
 impl Rbpf {
@@ -201,6 +130,7 @@ impl Rbpf {
             calibration: OdometryCalibration::default(),
             scan_odometry,
             counters: Counters::default(),
+            corrections: Vec::new(),
         })
     }
 
@@ -574,6 +504,10 @@ impl Rbpf {
         let last_old = nodes.last().map(|n| n.pose);
         let mut chain: Option<Arc<TrajectoryNode>> = None;
         for (n, p) in nodes.iter().zip(&poses) {
+            if n.pose != *p {
+                let (before, after) = (n.pose.to_pose(), p.to_pose());
+                self.corrections.push(Correction { stamp: n.stamp, before, after });
+            }
             chain = Some(Arc::new(TrajectoryNode { stamp: n.stamp, pose: *p, scan: n.scan.clone(), parent: chain }));
         }
         let moved = match (last_old, poses.last()) {
@@ -644,5 +578,47 @@ impl Rbpf {
             trajectory_nodes: nodes.len(),
             trajectory_bytes: nodes.len() * std::mem::size_of::<TrajectoryNode>() + scan_bytes,
         }
+    }
+}
+
+impl SlamBackend for Rbpf {
+    fn process(&mut self, odom: &Odometry, scan: &LaserScan) -> Result<UpdateOutcome, SlamError> {
+        Rbpf::process(self, odom, scan)
+    }
+
+    fn finish(&mut self) -> Option<LoopClosureReport> {
+        self.params.loop_closure.enabled.then(|| self.close_loops())
+    }
+
+    fn map(&self) -> Result<OccupancyGrid, SlamError> {
+        Rbpf::map(self)
+    }
+
+    fn live_map(&self) -> Option<OccupancyGrid> {
+        Rbpf::live_map(self)
+    }
+
+    fn best_pose(&self) -> Pose2 {
+        Rbpf::best_pose(self)
+    }
+
+    fn trajectory(&self) -> Vec<(f64, Pose2)> {
+        Rbpf::trajectory(self)
+    }
+
+    fn take_corrections(&mut self) -> Vec<Correction> {
+        std::mem::take(&mut self.corrections)
+    }
+
+    fn odometry_pose(&self) -> Option<Pose2> {
+        Rbpf::odometry_pose(self)
+    }
+
+    fn hypotheses(&self) -> Hypotheses {
+        Hypotheses { poses: self.particles().collect(), effective: Some(self.neff) }
+    }
+
+    fn counters(&self) -> Counters {
+        self.counters
     }
 }

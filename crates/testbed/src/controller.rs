@@ -1,8 +1,30 @@
-//! Controllers: pure pursuit along waypoints, and frontier exploration on the robot's own map.
+//! Controllers: pure pursuit along waypoints, frontier exploration on the robot's own map, or none.
 
 use mrslam_core::{CellState, LaserScan, OccupancyGrid, Pose2, Xyt};
 use nalgebra::Point2;
 use std::collections::VecDeque;
+
+/// What drives a robot during a run.
+#[derive(Debug, Clone)]
+pub enum Controller {
+    /// Follows a scripted route, steered by the robot's true pose (as an operator would drive it).
+    Waypoints(PurePursuit),
+    /// Explores frontiers of the robot's own SLAM map, steered by its SLAM pose.
+    Explore(Explorer),
+    /// Stands still where it started.
+    Idle,
+}
+
+impl Controller {
+    /// True once the route is driven or the exploration is over; always for an idle robot.
+    pub fn is_done(&self) -> bool {
+        match self {
+            Controller::Waypoints(p) => p.is_done(),
+            Controller::Explore(e) => e.is_done(),
+            Controller::Idle => true,
+        }
+    }
+}
 
 /// Pure pursuit (Coulter 1992) along a polyline of waypoints, with speed and acceleration limits.
 #[derive(Debug, Clone)]

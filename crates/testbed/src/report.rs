@@ -96,13 +96,14 @@ pub struct RunReport {
     pub steps: u64,
     /// Simulated time at which the maps were merged.
     pub merge_at_s: f64,
-    /// Host map of the merge, and the map merged into it.
+    /// The robots whose maps were merged: the host (the merge's frame), and the robot whose map was merged into
+    /// it. With more than two robots, the others' maps are evaluated but not merged.
     pub merge_pair: [String; 2],
     /// Per-robot results, by name.
     pub robots: BTreeMap<String, RobotReport>,
     /// One entry per algorithm.
     pub merges: Vec<MergeResult>,
-    /// Jaccard overlap of the true cells the two robots observed.
+    /// Jaccard overlap of the true cells the two robots of the merge pair observed.
     pub observed_overlap: f64,
 }
 
@@ -132,6 +133,10 @@ impl RunReport {
                 r.distance_m,
                 if r.finished { "" } else { ", route NOT finished" }
             );
+        }
+        if self.robots.len() > 2 {
+            let [host, other] = &self.merge_pair;
+            s += &format!("  merges of {host}'s and {other}'s maps (the other robots' maps are not merged)\n");
         }
         for m in &self.merges {
             let at_end = match (m.rotation_error_at_end_deg, m.translation_error_at_end_m) {

@@ -47,17 +47,17 @@ pub struct RobotInfo {
     pub start: Pose2,
 }
 
-/// The SLAM filter's state after an update, as plain data.
-pub struct SlamState<'a, P: Iterator<Item = (Pose2, f64)>> {
-    /// Scans given to the filter so far (nothing is logged when unchanged).
+/// A robot's SLAM after an update, as plain data.
+pub struct SlamState<'a> {
+    /// Scans given to the SLAM so far (nothing is logged when unchanged).
     pub scans: usize,
-    /// Best particle's pose, map frame.
+    /// The best pose estimate, map frame.
     pub best: &'a Pose2,
-    /// Particles (pose in the map frame, normalised weight).
-    pub particles: P,
-    /// Effective sample size.
-    pub neff: f64,
-    /// Resamplings so far.
+    /// The pose hypotheses (map frame) with their normalised weights: a particle filter's particles.
+    pub hypotheses: &'a [(Pose2, f64)],
+    /// How many hypotheses effectively count (a particle filter's Neff), when the SLAM has such a number.
+    pub effective: Option<f64>,
+    /// Resamplings so far (0 for a SLAM that does not resample).
     pub resamples: usize,
     /// True pose of the SLAM map frame in the world (the robot's true pose at its first processed scan), once
     /// known.
@@ -236,7 +236,7 @@ impl RunRecorder {
     }
 
     /// Robot `i`'s SLAM after this step's updates; logs nothing when it took no scan since the last call.
-    pub fn slam<P: Iterator<Item = (Pose2, f64)>>(&mut self, i: usize, s: SlamState<'_, P>) {
+    pub fn slam(&mut self, i: usize, s: SlamState<'_>) {
         let Some(t) = self.tracks.get_mut(i) else { return };
         if s.scans == t.scans {
             return;
@@ -258,9 +258,10 @@ impl RunRecorder {
         let slam_world = t.frame.map(|f| f * s.best);
         let truth = t.truth;
         self.rec.log_pose(&paths::robot(&name, &["slam", "pose"]), s.best, lighten(c, 0.25), "SLAM");
-        let particles: Vec<(Pose2, f64)> = s.particles.collect();
-        self.rec.log_particles(&paths::robot(&name, &["slam", "particles"]), &particles);
-        self.rec.log_scalar(&paths::metric("neff", &[&name]), s.neff);
+        self.rec.log_particles(&paths::robot(&name, &["slam", "particles"]), s.hypotheses);
+        if let Some(neff) = s.effective {
+            self.rec.log_scalar(&paths::metric("neff", &[&name]), neff);
+        }
         if let (Some(est), Some(truth)) = (slam_world, truth) {
             let err = (est.translation.vector - truth.translation.vector).norm();
             self.rec.log_scalar(&paths::metric("error", &[&name, "slam"]), err);

@@ -1,0 +1,150 @@
+//! One robot of a run: its place in the simulator, its SLAM back-end, its controller, and what the
+//! evaluation needs of its drive.
+
+use super::options::RunError;
+use crate::controller::{Controller, Explorer, PurePursuit, blocked_ahead};
+use crate::scenario::{ControllerKind, RobotSetup, Scenario};
+use mrslam_core::{CellTraversal, LaserScan, OccupancyGrid, Odometry, Pose2};
+use mrslam_sim::{RobotId, Sim};
+use mrslam_slam::{Rbpf, SlamBackend};
+use nalgebra::Point2;
+use std::time::Instant;
+
+/// A scan of one simulation step with the odometry and the true pose it was taken at.
+pub(super) type Reading = (LaserScan, Odometry, Pose2);
+
+/// Per-robot state of a run.
+pub(super) struct Agent<'s> {
+    pub setup: &'s RobotSetup,
+    pub id: RobotId,
+    /// The robot's SLAM. A trait object: each robot of a scenario may run its own back-end.
+    pub slam: Box<dyn SlamBackend>,
+    pub controller: Controller,
+    /// The latest scan, for the explorer's look ahead.
+    pub last_scan: Option<LaserScan>,
+    /// (truth, odometry) at each processed scan, in the world and odometry frames.
+    pub processed: Vec<(Pose2, Pose2)>,
+    pub scans: usize,
+    pub distance: f64,
+    pub last: Pose2,
+    pub contact_steps: usize,
+    pub slam_s: f64,
+    /// Truth-map cells this robot's beams crossed or hit.
+    pub observed: Vec<bool>,
+}
+
+impl Agent<'_> {
+    /// True once the controller is done.
+    pub fn finished(&self) -> bool {
+        self.controller.is_done()
+    }
+
+    /// The SLAM error of this robot as a [`RunError`].
+    pub fn slam_error(&self, error: mrslam_slam::SlamError) -> RunError {
+        RunError::Slam { robot: self.setup.name.clone(), error }
+    }
+
+    /// The velocity command (m/s, rad/s) of this step, from the robot's true pose (a route is driven as an
+    /// operator would, by looking at the robot) or its own map and pose (exploration is autonomous).
+    pub fn command(&mut self, true_pose: &Pose2, dt: f64) -> Result<(f64, f64), RunError> {
+        match &mut self.controller {
+            Controller::Waypoints(p) => Ok(p.command(true_pose, dt)),
+            Controller::Explore(e) => {
+                let slam_pose = self.slam.best_pose();
+                if e.wants_plan() && !self.processed.is_empty() {
+                    let map =
+                        self.slam.map().map_err(|error| RunError::Slam { robot: self.setup.name.clone(), error })?;
+                    e.plan(&map, &slam_pose);
+                }
+                let (front, half_width) = self.setup.model.footprint.half_extents();
+                let reach = front + Explorer::STOP_DISTANCE;
+                let blocked = self
+                    .last_scan
+                    .as_ref()
+                    .is_some_and(|scan| blocked_ahead(scan, &self.setup.lidar.mount, reach, half_width + 0.05));
+                Ok(e.command(&slam_pose, dt, blocked))
+            }
+            Controller::Idle => Ok((0.0, 0.0)),
+        }
+    }
+
+    /// Feeds the scans of this step to SLAM, recording truth and odometry for evaluation.
+    pub fn process(&mut self, scans: Vec<Reading>, truth: &OccupancyGrid) -> Result<(), RunError> {
+        for (scan, odom, true_pose) in scans {
+            self.scans += 1;
+            mark_observed(&mut self.observed, truth, &scan, &(true_pose * self.setup.lidar.mount));
+            let t = Instant::now();
+            let outcome = self.slam.process(&odom, &scan).map_err(|error| self.slam_error(error))?;
+            self.slam_s += t.elapsed().as_secs_f64();
+            if outcome.is_processed() {
+                self.processed.push((true_pose, odom.pose));
+            }
+            self.last_scan = Some(scan);
+        }
+        Ok(())
+    }
+}
+
+/// Marks the truth cells a scan's beams cross, from the sensor's true pose.
+fn mark_observed(observed: &mut [bool], truth: &OccupancyGrid, scan: &LaserScan, sensor: &Pose2) {
+    let origin = Point2::new(sensor.translation.x, sensor.translation.y);
+    let (x0, y0) = truth.world_to_cell_f(&origin);
+    let w = truth.width();
+    for i in (0..scan.len()).step_by(2) {
+        let r = if scan.is_valid(i) {
+            scan.ranges[i] as f64
+        } else if scan.is_max_range(i) {
+            scan.range_max as f64
+        } else {
+            continue;
+        };
+        let (x1, y1) = truth.world_to_cell_f(&scan.point_at(sensor, i, r));
+        for (cx, cy) in CellTraversal::new(x0, y0, x1, y1) {
+            if truth.contains_cell(cx, cy) {
+                observed[cy as usize * w + cx as usize] = true;
+            }
+        }
+    }
+}
+
+/// Puts the scenario's robots into the simulator, each with its SLAM (the particle filter, seeded by the
+/// scenario's seed and the robot's place) and its controller.
+pub(super) fn add_robots<'s>(
+    scenario: &'s Scenario,
+    sim: &mut Sim,
+    truth: &OccupancyGrid,
+) -> Result<Vec<Agent<'s>>, RunError> {
+    let mut agents = Vec::new();
+    for (k, r) in scenario.robots.iter().enumerate() {
+        let id = sim.add_robot(&r.name, r.model.clone(), r.lidar.clone(), r.slip, r.encoder, r.start)?;
+        let slam = Rbpf::new(r.slam.clone(), r.lidar.mount, scenario.seed.wrapping_add(1 + k as u64))
+            .map_err(|error| RunError::Slam { robot: r.name.clone(), error })?;
+        let controller = match r.controller {
+            ControllerKind::Waypoints => {
+                let mut p = PurePursuit::new(r.route.clone(), r.speed);
+                p.lookahead = r.lookahead;
+                Controller::Waypoints(p)
+            }
+            ControllerKind::Explore => {
+                let clearance = r.model.footprint.bounding_radius() + Explorer::MARGIN;
+                Controller::Explore(Explorer::new(r.speed, clearance))
+            }
+            ControllerKind::Idle => Controller::Idle,
+        };
+        agents.push(Agent {
+            setup: r,
+            id,
+            slam: Box::new(slam),
+            controller,
+            last_scan: None,
+            processed: Vec::new(),
+            scans: 0,
+            distance: 0.0,
+            last: r.start,
+            contact_steps: 0,
+            slam_s: 0.0,
+            observed: vec![false; truth.width() * truth.height()],
+        });
+    }
+    Ok(agents)
+}

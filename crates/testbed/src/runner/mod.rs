@@ -1,0 +1,132 @@
+//! The simulation loop: drive the robots, run their SLAMs, merge two of their maps, evaluate against truth.
+//!
+//! A run (`run`) sets up the simulator and one agent per robot (`agent`: its SLAM back-end and controller),
+//! drives until the merge time (`drive`), scores each robot's SLAM (`evaluate`), merges the pair of maps the
+//! scenario names (`merge`) and returns a [`RunOutput`] that `write_outputs` writes (`outputs`); with a
+//! recording asked for, `record` hands the rerun recorder plain data along the way.
+
+mod agent;
+mod drive;
+mod evaluate;
+mod merge;
+mod options;
+mod outputs;
+mod record;
+
+pub use options::{RunError, RunOptions, RunOutput};
+pub use outputs::{merge_overlay, write_outputs};
+pub use record::merge_view;
+
+use crate::report::RunReport;
+use crate::scenario::Scenario;
+use mrslam_merge::{
+    Algorithm, Cascade, CorrelativeMerger, CorrelativeParams, MatchParams, Merger, RmapMerger, RmapParams, SiftMerger,
+    SiftMergerParams,
+};
+use mrslam_sim::{Sim, SimConfig};
+use std::time::Instant;
+
+/// Builds `algorithm`'s merger with the scenario's merge settings, its random draws seeded by the scenario's seed.
+pub fn merger_for(algorithm: Algorithm, scenario: &Scenario) -> Box<dyn Merger> {
+    let m = &scenario.merge;
+    let mut sift = SiftMergerParams {
+        model: m.model,
+        encoding: m.encoding,
+        matching: MatchParams { ratio: m.ratio, candidates: m.candidates, ..MatchParams::default() },
+        hypotheses: m.hypotheses,
+        wall_dilation: m.wall_dilation,
+        ..SiftMergerParams::default()
+    };
+    sift.ransac.seed = scenario.seed;
+    match algorithm {
+        Algorithm::Sift => Box::new(SiftMerger::new(sift)),
+        Algorithm::Rmap => {
+            let mut p = RmapParams::default();
+            p.orient.seed = scenario.seed;
+            Box::new(RmapMerger::new(p))
+        }
+        Algorithm::Correlative => Box::new(CorrelativeMerger::default()),
+        Algorithm::Cascade => Box::new(Cascade::new(sift, CorrelativeParams::default())),
+    }
+}
+
+/// Runs a scenario end to end: the robots drive and map until the merge time (`drive`), each robot's
+/// SLAM is evaluated against the truth (`evaluate_robots`), then the merge pair's maps are merged by each
+/// algorithm and every merge is scored against the true transform (`merge_maps`).
+pub fn run(scenario: &Scenario, mut opts: RunOptions) -> Result<RunOutput, RunError> {
+    let wall = Instant::now();
+    let (host, other) = merge::merge_pair(scenario)?;
+    let config = SimConfig { dt: scenario.dt, ..SimConfig::default() };
+    let mut sim = Sim::with_config(&scenario.world, scenario.seed, config)?;
+    let truth = sim.true_map(scenario.truth_resolution)?;
+    let mut agents = agent::add_robots(scenario, &mut sim, &truth)?;
+    let algorithms = opts.algorithms.clone().unwrap_or_else(|| scenario.merge.algorithms.clone());
+    if let Some(v) = opts.viz.as_deref_mut() {
+        record::viz_begin(v, &sim, &truth, &agents, &algorithms);
+    }
+    let steps = drive::drive(scenario, &mut sim, &mut agents, &truth, &mut opts)?;
+    let merge_at = sim.time();
+    if let Some(v) = opts.viz.as_deref_mut() {
+        v.set_time(steps, merge_at);
+    }
+    // The data ends for every SLAM when the drive ends: the particle filter closes loops there when its
+    // parameters ask for it, as `mrslam slam` does at the end of a log (no preset of the simulated robots does).
+    for a in agents.iter_mut() {
+        a.slam.finish();
+    }
+    let evaluated = evaluate::evaluate_robots(&agents, &truth, &mut opts)?;
+    let mergers: Vec<(Algorithm, Box<dyn Merger>)> = algorithms.iter().map(|&a| (a, merger_for(a, scenario))).collect();
+    let pair = (host.as_str(), other.as_str());
+    let (results, merges) = merge::merge_maps(scenario, &mergers, &evaluated, pair, &truth, &mut opts);
+    let observed_overlap = merge::observed_overlap(&agents, pair);
+    let report = RunReport {
+        scenario: scenario.name.clone(),
+        seed: scenario.seed,
+        sim_s: merge_at,
+        wall_s: wall.elapsed().as_secs_f64(),
+        steps,
+        merge_at_s: merge_at,
+        merge_pair: [host, other],
+        robots: evaluated.robots,
+        merges: results,
+        observed_overlap,
+    };
+    Ok(RunOutput { report, maps: evaluated.maps, truth, merges, frames: evaluated.frames, paths: evaluated.paths })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::Path;
+
+    fn two_rooms() -> Scenario {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenarios/paper_two_rooms.toml");
+        Scenario::from_file(&path).unwrap()
+    }
+
+    #[test]
+    fn a_scenario_changed_in_code_is_refused_before_the_run_not_by_a_panic() {
+        let refused = |s: &Scenario| match run(s, RunOptions::default()) {
+            Err(RunError::Scenario(m)) => m,
+            Err(e) => panic!("unexpected error {e}"),
+            Ok(_) => panic!("the run went ahead"),
+        };
+        let mut s = two_rooms();
+        s.robots.pop();
+        assert_eq!(refused(&s), "a run takes at least two robots (a merge needs two maps), found 1");
+        let mut s = two_rooms();
+        s.merge.host = "nobody".into();
+        assert_eq!(refused(&s), "the merge host `nobody` is not one of the robots");
+        let mut s = two_rooms();
+        s.robots[1].name = s.robots[0].name.clone();
+        assert!(refused(&s).contains("share the name"));
+    }
+
+    #[test]
+    fn every_algorithm_gets_its_own_merger() {
+        let s = two_rooms();
+        for a in Algorithm::ALL {
+            assert_eq!(merger_for(a, &s).name(), a.name());
+        }
+    }
+}

@@ -1,0 +1,60 @@
+//! What a run takes besides its scenario, what it gives back, and what can stop it.
+
+use crate::report::RunReport;
+use mrslam_core::map_io::MapIoError;
+use mrslam_core::{OccupancyGrid, Pose2};
+use mrslam_merge::{Algorithm, MergeOutcome};
+use mrslam_sim::SimError;
+use mrslam_slam::SlamError;
+use mrslam_viz::RunRecorder;
+use std::collections::BTreeMap;
+
+/// What can stop a run.
+#[derive(Debug, thiserror::Error)]
+pub enum RunError {
+    /// The simulator refused something (e.g. a start inside an obstacle).
+    #[error("simulator: {0}")]
+    Sim(#[from] SimError),
+    /// A SLAM filter refused its input or parameters.
+    #[error("SLAM of robot `{robot}`: {error}")]
+    Slam {
+        /// Robot.
+        robot: String,
+        /// What went wrong.
+        error: SlamError,
+    },
+    /// Writing outputs failed.
+    #[error("{0}")]
+    Io(#[from] MapIoError),
+    /// The scenario is not one a run can take (its fields are public, so it may not come from a file).
+    #[error("scenario: {0}")]
+    Scenario(String),
+}
+
+/// Options of a run that are not part of the scenario.
+#[derive(Default)]
+pub struct RunOptions<'a> {
+    /// Merge algorithms to run instead of the scenario's.
+    pub algorithms: Option<Vec<Algorithm>>,
+    /// Called about once per simulated second with (simulated time, expected end of the run): the merge
+    /// time, the duration, or at a rendezvous of routed robots the time their remaining routes take.
+    pub progress: Option<Box<dyn FnMut(f64, f64) + 'a>>,
+    /// Records the run for the rerun viewer; `None` (the default) records and converts nothing.
+    pub viz: Option<&'a mut RunRecorder>,
+}
+
+/// Everything a run produced.
+pub struct RunOutput {
+    /// The report.
+    pub report: RunReport,
+    /// Each robot's final map (best particle), by robot name, in its own SLAM frame.
+    pub maps: BTreeMap<String, OccupancyGrid>,
+    /// The true map (world frame).
+    pub truth: OccupancyGrid,
+    /// Merge outcomes, in algorithm order (with merged maps when accepted).
+    pub merges: Vec<MergeOutcome>,
+    /// Each robot's SLAM frame in the world (its true pose at its first processed scan), by robot name.
+    pub frames: BTreeMap<String, Pose2>,
+    /// Each robot's SLAM path (the best particle's pose at every processed scan, its own frame), by robot name.
+    pub paths: BTreeMap<String, Vec<Pose2>>,
+}

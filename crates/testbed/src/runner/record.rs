@@ -1,0 +1,109 @@
+//! The rerun hooks of a run: called only when `RunOptions::viz` is set; they hand plain data to mrslam-viz.
+
+use super::agent::{Agent, Reading};
+use super::options::RunError;
+use mrslam_core::{OccupancyGrid, Pose2};
+use mrslam_merge::{Algorithm, MergeOutcome};
+use mrslam_sim::{Obstacle, Sim, StepEvents};
+use mrslam_viz::{MergeView, RobotInfo, RunRecorder, SlamState};
+use nalgebra::Point2;
+
+/// What the rerun recording shows of a merge of `host`'s map (a) and `other`'s (b); `error` against the truth
+/// (rotation radians, translation metres) when known.
+pub fn merge_view<'a>(
+    out: &'a MergeOutcome,
+    host: &'a str,
+    other: &'a str,
+    error: Option<(f64, f64)>,
+) -> MergeView<'a> {
+    MergeView {
+        algorithm: &out.report.algorithm,
+        host,
+        other,
+        accepted: out.report.accepted,
+        reason: out.report.reason.as_deref(),
+        matches: out.report.matches,
+        inliers: out.report.inliers,
+        transform: out.report.transform.map(|t| t.to_pose()),
+        error,
+        points_a: &out.evidence.points_a,
+        points_b: &out.evidence.points_b,
+        inlier_pairs: &out.evidence.inlier_pairs,
+        merged: out.merged.as_ref(),
+    }
+}
+
+/// The world's obstacles as closed outlines (circles as 24-gons).
+fn viz_walls(sim: &Sim) -> Vec<Vec<Point2<f64>>> {
+    sim.world()
+        .obstacles()
+        .iter()
+        .map(|o| match o {
+            Obstacle::Circle { center, radius } => (0..24)
+                .map(|k| {
+                    let a = k as f64 * std::f64::consts::TAU / 24.0;
+                    Point2::new(center.x + radius * a.cos(), center.y + radius * a.sin())
+                })
+                .collect(),
+            other => other.outline(),
+        })
+        .collect()
+}
+
+/// Static content and layout.
+pub(super) fn viz_begin(
+    v: &mut RunRecorder,
+    sim: &Sim,
+    truth: &OccupancyGrid,
+    agents: &[Agent],
+    algorithms: &[Algorithm],
+) {
+    let robots: Vec<RobotInfo> =
+        agents.iter().map(|a| RobotInfo { name: a.setup.name.clone(), start: a.setup.start }).collect();
+    let algorithms: Vec<String> = algorithms.iter().map(Algorithm::to_string).collect();
+    v.set_time(0, sim.time());
+    v.begin(&viz_walls(sim), truth, &robots, &algorithms);
+}
+
+/// A step: slip and contacts, and this step's scans with the true and odometry poses they were taken at.
+pub(super) fn viz_step(
+    v: &mut RunRecorder,
+    step: u64,
+    time: f64,
+    agents: &[Agent],
+    events: &StepEvents,
+    batches: &[Vec<Reading>],
+) {
+    v.set_time(step, time);
+    for (k, ((a, ev), batch)) in agents.iter().zip(&events.robots).zip(batches).enumerate() {
+        v.robot_step(k, ev.slipping, ev.contact);
+        for (scan, odom, pose) in batch {
+            v.scan(k, pose, &odom.pose, scan, &a.setup.lidar.mount);
+        }
+    }
+}
+
+/// The SLAMs after this step's updates: best pose, hypotheses (particles and Neff); paths and maps when due.
+pub(super) fn viz_slam(v: &mut RunRecorder, agents: &[Agent]) -> Result<(), RunError> {
+    for (k, a) in agents.iter().enumerate() {
+        let hypotheses = a.slam.hypotheses();
+        let state = SlamState {
+            scans: a.scans,
+            best: &a.slam.best_pose(),
+            hypotheses: &hypotheses.poses,
+            effective: hypotheses.effective,
+            resamples: a.slam.counters().resamples,
+            frame: a.processed.first().map(|p| p.0),
+        };
+        v.slam(k, state);
+        if v.paths_due(k) {
+            let traj: Vec<Pose2> = a.slam.trajectory().into_iter().map(|(_, p)| p).collect();
+            v.paths(k, &traj);
+        }
+        if v.map_due(k) {
+            let map = a.slam.map().map_err(|error| a.slam_error(error))?;
+            v.map(k, &map);
+        }
+    }
+    Ok(())
+}
