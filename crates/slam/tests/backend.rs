@@ -43,7 +43,8 @@ fn a_loop_closure_reports_the_poses_it_moved_once() {
 #[test]
 fn the_filter_shows_its_particles_as_hypotheses_and_reports_no_correction_without_loop_closure() {
     let run = sick_office_run(5);
-    let params = SlamParams { particles: 8, ..SlamParams::hokuyo() };
+    let mut params = SlamParams::hokuyo();
+    params.filter.particles = 8;
     let mut filter = Rbpf::new(params, run.laser_offset, 3).unwrap();
     let n = 80;
     for (o, s) in run.odometry.iter().zip(&run.scans).take(n) {
