@@ -3,5 +3,6 @@
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {
-    let _ = mrslam_core::CarmenLog::parse(data, std::path::Path::new("fuzz.clf"));
+    let options = mrslam_log::ReadOptions::default();
+    let _ = mrslam_log::carmen::parse(data, std::path::Path::new("fuzz.clf"), &options);
 });

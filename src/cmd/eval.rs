@@ -3,7 +3,7 @@
 
 use anyhow::{Result, bail};
 use clap::Subcommand;
-use mrslam_core::map_io::write_file_atomic;
+use mrslam_core::output::write_file_atomic;
 use mrslam_core::relations::{self, RelationsScore};
 use serde_json::{Value, json};
 use std::path::{Path, PathBuf};

@@ -2,7 +2,8 @@
 
 use anyhow::{Context, Result, bail};
 use clap::Args;
-use mrslam_core::map_io::{self, write_file_atomic};
+use mrslam_core::map_io;
+use mrslam_core::output::write_file_atomic;
 use mrslam_merge::MapEncoding;
 use mrslam_merge::MapImage;
 use mrslam_sift::{Features, GrayImage, Sift, SiftParams};

@@ -2,8 +2,7 @@
 
 use anyhow::Result;
 use clap::{Args, Subcommand};
-use mrslam_core::MAX_STEP_BACK;
-use mrslam_core::{CarmenLog, OdometrySource, ReadOptions};
+use mrslam_log::{MAX_STEP_BACK, OdometrySource, ReadOptions, SensorLog, read_log};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -30,7 +29,7 @@ pub struct ReadArgs {
 
 impl ReadArgs {
     /// Reads `path` with these options.
-    pub fn read(&self, path: &Path) -> Result<CarmenLog> {
+    pub fn read(&self, path: &Path) -> Result<SensorLog> {
         if !(self.max_step_back.is_finite() && self.max_step_back >= 0.0) {
             anyhow::bail!("--max-step-back {}: must be a non-negative number of seconds", self.max_step_back);
         }
@@ -43,7 +42,7 @@ impl ReadArgs {
             repair_reversing: !self.keep_reversing,
             scan_latency: self.scan_latency,
         };
-        Ok(CarmenLog::read_with(path, &options)?)
+        Ok(read_log(path, &options)?)
     }
 }
 

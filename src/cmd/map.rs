@@ -138,10 +138,10 @@ pub fn load_map(path: &Path, resolution: f64) -> Result<OccupancyGrid> {
 pub fn save_map(grid: &OccupancyGrid, path: &Path) -> Result<()> {
     match extension(path).as_str() {
         "yaml" | "yml" => map_io::write_ros_map_with_preview(grid, path)?,
-        "pgm" => map_io::write_file_atomic(path, &map_io::encode_pgm(&map_io::grid_to_image(grid)))?,
+        "pgm" => mrslam_core::output::write_file_atomic(path, &map_io::encode_pgm(&map_io::grid_to_image(grid)))?,
         "png" => {
             let img: GreyImage = map_io::grid_to_image(grid);
-            map_io::write_file_atomic(path, &map_io::encode_png(&img, path)?)?
+            mrslam_core::output::write_file_atomic(path, &map_io::encode_png(&img, path)?)?
         }
         other => bail!("{}: unknown output format `.{other}` (expected .yaml, .pgm or .png)", path.display()),
     }

@@ -4,7 +4,8 @@ use anyhow::{Context, Result, bail};
 use clap::Args;
 use clap::builder::{PossibleValuesParser, TypedValueParser};
 use mrslam_core::OccupancyGrid;
-use mrslam_core::map_io::{self, write_file_atomic};
+use mrslam_core::map_io;
+use mrslam_core::output::write_file_atomic;
 use mrslam_merge::MapImage;
 use mrslam_merge::{
     Algorithm, BoundaryWalls, Cascade, CorrelativeMerger, CorrelativeParams, Evidence, FusionRule, MapEncoding,

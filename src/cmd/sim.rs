@@ -4,8 +4,8 @@ use super::replay_plot;
 use anyhow::{Context, Result, bail};
 use clap::Subcommand;
 use mrslam_core::Pose2;
-use mrslam_core::ScanRecord;
 use mrslam_core::relations::{self, pose_at};
+use mrslam_log::ScanRecord;
 use mrslam_sim::odometry_errors::{OdometryErrors, drive_along, odometry_errors};
 use mrslam_sim::odometry_fit::{fit, worst_relative};
 use mrslam_sim::replay::{BandStats, OUTLIER_M, ReplayReport, replay};
@@ -134,7 +134,7 @@ pub fn run(cmd: SimCommand) -> Result<ExitCode> {
                 .filter_map(|r| {
                     let pose = match &traj {
                         Some(t) => pose_at(t, r.scan.stamp, tolerance),
-                        None => Some(r.logged_laser_pose * r.laser_offset.inverse()),
+                        None => r.logged_laser_pose.map(|p| p * r.laser_offset.inverse()),
                     };
                     if pose.is_none() {
                         unplaced += 1;

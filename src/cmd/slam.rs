@@ -1,14 +1,15 @@
 //! `mrslam slam LOG -o MAP.yaml`: GMapping-style SLAM on a CARMEN log.
 //!
 //! Leniency: NaN/negative beams are counted and ignored; scans whose odometry did not move enough are
-//! skipped (counted); sensor lines out of stamp order are reordered and repeated scans dropped (core's reader,
-//! counted and reported). Errors naming the log line: a malformed line, stamps stepping back by more than
+//! skipped (counted); sensor lines out of stamp order are reordered and repeated scans dropped (mrslam-log's
+//! repairs, counted and reported). Errors naming the log line: a malformed line, stamps stepping back by more than
 //! `--max-step-back`, non-finite odometry or scan geometry.
 
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use mrslam_core::map_io::{self, write_file_atomic};
+use mrslam_core::map_io;
+use mrslam_core::output::write_file_atomic;
 use mrslam_core::relations::{self, StampedPose};
 use mrslam_core::{Odometry, Pose2};
 use mrslam_slam::synthetic::{Drift, inject_drift};
@@ -192,8 +193,7 @@ pub fn run(args: SlamArgs) -> Result<ExitCode> {
     let offset: Pose2 = log.scans[0].laser_offset;
     let mut filter = Rbpf::new(params, offset, args.seed).context("slam parameters")?;
     // The recording's destinations are opened before the long work, so that a bad one fails at once.
-    let name = args.log.file_name().map_or_else(|| "log".to_string(), |n| n.to_string_lossy().into_owned());
-    let name = name.trim_end_matches(".gz").trim_end_matches(".clf").trim_end_matches(".log").to_string();
+    let name = mrslam_log::log_name(&args.log);
     let mut viz = args
         .viz
         .open(&format!("slam-{name}-{}-seed{}", args.preset, args.seed), &format!("slam {name}"))?
@@ -245,7 +245,7 @@ pub fn run(args: SlamArgs) -> Result<ExitCode> {
     })
     .map_err(|e| match e {
         LogRunError::Reading { index, error } => {
-            anyhow::anyhow!("{}:{}: {error}", args.log.display(), log.scans[index].line)
+            anyhow::anyhow!("{}: {error}", log.scans[index].source.in_file(&args.log))
         }
         LogRunError::NothingProcessed => anyhow::anyhow!("the filter processed no scan: no trajectory"),
     })?;
@@ -299,13 +299,13 @@ pub fn run(args: SlamArgs) -> Result<ExitCode> {
     if let Some(worst) = jumps.iter().max_by(|a, b| a.distance.total_cmp(&b.distance)) {
         println!(
             "warning: the odometry jumps {} times (faster than {MAX_SPEED} m/s or {MAX_TURN_RATE} rad/s between scans; \
-             largest {:.2} m and {:.2} rad in {:.3} s at line {}); the filter drew its particles through each jump \
+             largest {:.2} m and {:.2} rad in {:.3} s at {}); the filter drew its particles through each jump \
              with the motion model's noise, so the map around it may be wrong",
             jumps.len(),
             worst.distance,
             worst.turn,
             worst.seconds,
-            worst.line
+            worst.at
         );
     }
     println!(
@@ -403,7 +403,7 @@ fn record_the_end(
     filter: &Rbpf,
     map: &mrslam_core::OccupancyGrid,
     run: &LogRun,
-    scans: &[mrslam_core::ScanRecord],
+    scans: &[mrslam_log::ScanRecord],
     score: Option<&relations::RelationsScore>,
 ) -> Result<()> {
     let stamp0 = scans[0].scan.stamp;
@@ -450,8 +450,8 @@ const MAX_TURN_RATE: f64 = 10.0;
 
 /// An odometry jump between two consecutive scans.
 struct OdometryJump {
-    /// Log line of the later scan.
-    line: usize,
+    /// Where the later scan is in the log.
+    at: mrslam_log::Source,
     /// Metres moved.
     distance: f64,
     /// Radians turned.
@@ -462,7 +462,7 @@ struct OdometryJump {
 
 /// The increments between consecutive scans' odometry that no robot drives: faster than [`MAX_SPEED`] or
 /// [`MAX_TURN_RATE`] (over at least 0.1 s, so that stamp jitter does not make a slow move look fast).
-fn odometry_jumps(odometry: &[Odometry], scans: &[mrslam_core::ScanRecord]) -> Vec<OdometryJump> {
+fn odometry_jumps(odometry: &[Odometry], scans: &[mrslam_log::ScanRecord]) -> Vec<OdometryJump> {
     let mut jumps = Vec::new();
     for (k, w) in odometry.windows(2).enumerate() {
         let step = w[0].pose.inv_mul(&w[1].pose);
@@ -470,7 +470,7 @@ fn odometry_jumps(odometry: &[Odometry], scans: &[mrslam_core::ScanRecord]) -> V
         let seconds = w[1].stamp - w[0].stamp;
         let span = seconds.max(0.1);
         if distance > MAX_SPEED * span || turn > MAX_TURN_RATE * span {
-            jumps.push(OdometryJump { line: scans[k + 1].line, distance, turn, seconds });
+            jumps.push(OdometryJump { at: scans[k + 1].source.clone(), distance, turn, seconds });
         }
     }
     jumps

@@ -3,7 +3,7 @@
 use anyhow::{Context, Result, bail};
 use clap::Subcommand;
 use mrslam_core::Xyt;
-use mrslam_core::map_io::write_file_atomic;
+use mrslam_core::output::write_file_atomic;
 use mrslam_sim::from_map::{START_CLEARANCE_M, start_poses, world_toml};
 use mrslam_sim::{World, WorldSpec};
 use std::path::{Path, PathBuf};

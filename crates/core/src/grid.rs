@@ -54,6 +54,9 @@ pub const OCCUPIED_LOGODDS: f32 = 0.619_039_2;
 /// Log-odds below which a cell is free: p = 0.35, the mirror of [`OCCUPIED_LOGODDS`].
 pub const FREE_LOGODDS: f32 = -0.619_039_2;
 
+/// Log-odds given to a definitely occupied (+) or free (−) cell read from a ROS map: p ≈ 0.88 / 0.12.
+pub const ROS_LOGODDS_LIMIT: f32 = 2.0;
+
 /// What is known of a cell.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum CellState {
@@ -243,10 +246,10 @@ impl OccupancyGrid {
 
     /// The grid as ROS `nav_msgs/OccupancyGrid` data: -1 unknown, else occupancy 0..100.
     ///
-    /// Cells at or beyond ±[`crate::map_io::ROS_LOGODDS_LIMIT`] (what a read ROS map holds for its
+    /// Cells at or beyond ±[`ROS_LOGODDS_LIMIT`] (what a read ROS map holds for its
     /// certain cells) become exactly 0 or 100, so ROS data survives a round trip.
     pub fn to_ros_int8(&self) -> Vec<i8> {
-        let lim = crate::map_io::ROS_LOGODDS_LIMIT;
+        let lim = ROS_LOGODDS_LIMIT;
         self.cells
             .iter()
             .map(|&l| match l {

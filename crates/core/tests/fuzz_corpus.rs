@@ -46,13 +46,6 @@ fn grey_image_corpus() {
 }
 
 #[test]
-fn carmen_log_corpus() {
-    for (path, bytes) in corpus("carmen_log") {
-        let _ = mrslam_core::CarmenLog::parse(bytes.as_slice(), &path);
-    }
-}
-
-#[test]
 fn relations_corpus() {
     for (path, bytes) in corpus("relations") {
         if let Ok(text) = std::str::from_utf8(&bytes)

@@ -56,7 +56,7 @@ impl StudyParams {
     pub fn write(&self, dir: &Path) -> Result<(), StudyError> {
         let path = dir.join(PARAMS_FILE);
         let text = serde_json::to_string_pretty(self).map_err(|e| StudyError::file(&path, e))? + "\n";
-        mrslam_core::map_io::write_file_atomic(&path, text.as_bytes()).map_err(|e| StudyError::file(&path, e))
+        mrslam_core::output::write_file_atomic(&path, text.as_bytes()).map_err(|e| StudyError::file(&path, e))
     }
 
     /// Fails, naming the first parameter that differs, unless `other` (read from `path`) is the same study.
@@ -159,7 +159,7 @@ impl Journal {
             text += &r.to_csv();
             text.push('\n');
         }
-        mrslam_core::map_io::write_file_atomic(&path, text.as_bytes()).map_err(|e| StudyError::file(&path, e))?;
+        mrslam_core::output::write_file_atomic(&path, text.as_bytes()).map_err(|e| StudyError::file(&path, e))?;
         let file = std::fs::OpenOptions::new().append(true).open(&path).map_err(|e| StudyError::file(&path, e))?;
         Ok((Journal { path, file: Mutex::new(file) }, done))
     }

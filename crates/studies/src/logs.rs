@@ -14,8 +14,9 @@ use super::StudyError;
 use super::algorithms::study_merger_encoded;
 use super::results::TrialRow;
 use mrslam_core::relations::{Relation, StampedPose, pose_at};
-use mrslam_core::{CellState, OccupancyGrid, Pose2, ScanRecord};
+use mrslam_core::{CellState, OccupancyGrid, Pose2};
 use mrslam_core::{Xyt, pose, pose::normalize_angle};
+use mrslam_log::{ScanRecord, span};
 use mrslam_merge::{Algorithm, MapEncoding, MergeParams, merge};
 use mrslam_slam::{LogRunError, Rbpf, SlamParams, map_log};
 use mrslam_testbed::eval::transform_error;
@@ -97,15 +98,12 @@ pub fn map_part(
         .map_err(|e| StudyError::Invalid(format!("slam parameters: {e}")))?;
     let run =
         map_log(&mut filter, scans.iter().map(|r| (&r.odometry, &r.scan)), |_, _| on_scan()).map_err(|e| match e {
-            LogRunError::Reading { index, error } => {
-                StudyError::file(log, format!("line {}: {error}", scans[index].line))
-            }
+            LogRunError::Reading { index, error } => StudyError::file(log, format!("{}: {error}", scans[index].source)),
             LogRunError::NothingProcessed => StudyError::file(
                 log,
                 format!(
-                    "lines {}..{}: the filter processed no scan of this part",
-                    first.line,
-                    scans.last().map_or(first.line, |r| r.line)
+                    "{}: the filter processed no scan of this part",
+                    span(&first.source, scans.last().map_or(&first.source, |r| &r.source))
                 ),
             ),
         })?;
@@ -477,7 +475,7 @@ pub fn write_pair_rows(rows: &[PairRow], path: &Path) -> Result<(), StudyError> 
     for r in rows {
         let _ = writeln!(s, "{}", r.to_csv());
     }
-    mrslam_core::map_io::write_file_atomic(path, s.as_bytes()).map_err(|e| StudyError::file(path, e))
+    mrslam_core::output::write_file_atomic(path, s.as_bytes()).map_err(|e| StudyError::file(path, e))
 }
 
 /// One algorithm over all pairs of a logs study.
@@ -554,7 +552,7 @@ pub fn write_algorithm_summary(rows: &[AlgorithmSummary], path: &Path) -> Result
             num(r.median_error_deg, 3)
         );
     }
-    mrslam_core::map_io::write_file_atomic(path, s.as_bytes()).map_err(|e| StudyError::file(path, e))
+    mrslam_core::output::write_file_atomic(path, s.as_bytes()).map_err(|e| StudyError::file(path, e))
 }
 
 /// The per-pair results and the summary as aligned text tables (what the CLI prints).

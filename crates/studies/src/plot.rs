@@ -156,7 +156,7 @@ pub fn write_rgb_png(buf: Vec<u8>, size: (u32, u32), path: &Path) -> Result<(), 
     let mut bytes = Vec::new();
     img.write_to(&mut std::io::Cursor::new(&mut bytes), image::ImageFormat::Png)
         .map_err(|e| StudyError::file(path, e))?;
-    mrslam_core::map_io::write_file_atomic(path, &bytes).map_err(|e| StudyError::file(path, e))
+    mrslam_core::output::write_file_atomic(path, &bytes).map_err(|e| StudyError::file(path, e))
 }
 
 #[cfg(test)]

@@ -134,7 +134,7 @@ pub fn write_results(rows: &[TrialRow], path: &Path) -> Result<(), StudyError> {
     for r in rows {
         let _ = writeln!(s, "{}", r.to_csv());
     }
-    mrslam_core::map_io::write_file_atomic(path, s.as_bytes()).map_err(|e| StudyError::file(path, e))
+    mrslam_core::output::write_file_atomic(path, s.as_bytes()).map_err(|e| StudyError::file(path, e))
 }
 
 /// Reads a `results.csv`, checking its header.

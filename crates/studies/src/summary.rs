@@ -119,7 +119,7 @@ pub fn write_summary(rows: &[SummaryRow], path: &Path) -> Result<(), StudyError>
             r.mean_overlap
         );
     }
-    mrslam_core::map_io::write_file_atomic(path, s.as_bytes()).map_err(|e| StudyError::file(path, e))
+    mrslam_core::output::write_file_atomic(path, s.as_bytes()).map_err(|e| StudyError::file(path, e))
 }
 
 /// The summary as an aligned text table (what the CLI prints).

@@ -6,9 +6,10 @@
 //! worst relations, `DETAIL=1` the long relations off by more than 0.12 m with their error in the first pose's frame,
 //! `DEBUG_RANGE=T0,T1` prints raw and filter odometry per scan stamped in [T0, T1].
 
+use mrslam_core::Pose2;
 use mrslam_core::Xyt;
 use mrslam_core::relations::{self, StampedPose};
-use mrslam_core::{CarmenLog, OdometrySource, Pose2, ReadOptions};
+use mrslam_log::{OdometrySource, ReadOptions, read_log};
 use mrslam_slam::{Preset, Rbpf, poses_at_every_scan};
 
 fn main() {
@@ -28,7 +29,7 @@ fn main() {
             _ => params.set(k, v).expect("a parameter"),
         }
     }
-    let log = CarmenLog::read_with(std::path::Path::new(&args[0]), &options).expect("a readable log");
+    let log = read_log(std::path::Path::new(&args[0]), &options).expect("a readable log");
     let rels = relations::read_relations(std::path::Path::new(&args[1])).expect("relations");
     let mut f = Rbpf::new(params, log.scans[0].laser_offset, seed).expect("parameters");
     let t = std::time::Instant::now();

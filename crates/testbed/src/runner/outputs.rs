@@ -56,6 +56,6 @@ pub fn write_outputs(out: &RunOutput, dir: &Path) -> Result<(), RunError> {
         }
     }
     let json = serde_json::to_vec_pretty(&out.report).expect("reports serialise");
-    map_io::write_file_atomic(&dir.join("report.json"), &json)?;
+    mrslam_core::output::write_file_atomic(&dir.join("report.json"), &json).map_err(MapIoError::from)?;
     Ok(())
 }

@@ -1,0 +1,68 @@
+//! How a log is read: where each scan's odometry comes from, and the bounds of the repairs.
+
+/// Where each scan's odometry comes from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum OdometrySource {
+    /// The odometry stream interpolated at the scan's stamp where two readings bracket it; the scan's own
+    /// odometry elsewhere (and in logs without an odometry stream). The default: a CARMEN scan line's
+    /// odometry fields hold whichever ODOM message arrived last, up to one odometry period away from the scan.
+    #[default]
+    Interpolated,
+    /// The odometry logged with the scan itself (CARMEN: FLASER/RLASER `odom_*`, ROBOTLASER1 robot pose), as
+    /// GMapping's log reader takes it.
+    Line,
+}
+
+impl std::str::FromStr for OdometrySource {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "interpolated" => Ok(OdometrySource::Interpolated),
+            "line" => Ok(OdometrySource::Line),
+            _ => Err(format!("unknown odometry source '{s}' (expected interpolated or line)")),
+        }
+    }
+}
+
+impl std::fmt::Display for OdometrySource {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            OdometrySource::Interpolated => "interpolated",
+            OdometrySource::Line => "line",
+        })
+    }
+}
+
+/// How a log is read.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ReadOptions {
+    /// Where each scan's odometry comes from.
+    pub odometry: OdometrySource,
+    /// A sensor reading stamped more than this many seconds before a sensor reading above it is refused.
+    ///
+    /// Real logs interleave sensors by arrival, so stamps step back by up to about one second (the
+    /// Radish logs: up to 0.9 s); a step of many seconds means two logs concatenated or a clock reset,
+    /// which reordering would silently scramble.
+    pub max_step_back: f64,
+    /// Repair odometry increments that report driving backwards (`tv` < 0) but move the pose forwards: some
+    /// robots' odometry integrates the speed's magnitude, so reversing reads as driving ahead. Counted in
+    /// [`Repairs::reversed_increments`](crate::Repairs::reversed_increments).
+    pub repair_reversing: bool,
+    /// Seconds by which each scan was taken before its stamp: odometry is interpolated at the stamp minus
+    /// this (0: at the stamp). Only with [`OdometrySource::Interpolated`].
+    pub scan_latency: f64,
+}
+
+/// The default bound on stamps stepping back, seconds ([`ReadOptions::max_step_back`]).
+pub const MAX_STEP_BACK: f64 = 5.0;
+
+impl Default for ReadOptions {
+    fn default() -> Self {
+        ReadOptions {
+            odometry: OdometrySource::Interpolated,
+            max_step_back: MAX_STEP_BACK,
+            repair_reversing: true,
+            scan_latency: 0.0,
+        }
+    }
+}

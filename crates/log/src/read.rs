@@ -1,0 +1,128 @@
+//! One entry point for every log: the format chosen by magic bytes or extension, then its reader.
+
+use crate::carmen;
+use crate::error::LogError;
+use crate::options::ReadOptions;
+use crate::sensor_log::SensorLog;
+use std::io::{BufRead, BufReader, Read};
+use std::path::Path;
+
+/// The log formats this crate reads.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Format {
+    /// CARMEN text lines (`.clf`, `.log`).
+    Carmen,
+}
+
+/// The gzip magic bytes: a compressed log is decompressed before its format is told.
+const GZIP_MAGIC: [u8; 2] = [0x1f, 0x8b];
+
+/// The file name's extensions each format uses (after a `.gz` is taken off).
+const EXTENSIONS: &[(&str, Format)] = &[(".clf", Format::Carmen), (".log", Format::Carmen)];
+
+/// The format of `path` by its name: `.clf`, `.log`, their `.gz` variants and a bare `.gz` are CARMEN.
+pub fn format_by_extension(path: &Path) -> Option<Format> {
+    let name = path.file_name()?.to_string_lossy().to_ascii_lowercase();
+    let (name, gz) = match name.strip_suffix(".gz") {
+        Some(stem) => (stem.to_string(), true),
+        None => (name, false),
+    };
+    EXTENSIONS.iter().find(|(ext, _)| name.ends_with(ext)).map(|&(_, f)| f).or(gz.then_some(Format::Carmen))
+}
+
+/// The format of a (decompressed) log by its first bytes: CARMEN when it is text whose first word is a
+/// comment or an upper-case record kind (`PARAM`, `FLASER`, `ODOM`, ...).
+pub fn format_by_content(head: &[u8]) -> Option<Format> {
+    // Binary formats (a ROS 1 bag's `#ROSBAG V2.0`, MCAP's `\x89MCAP0\r\n`, `SQLite format 3\0`) are told
+    // here, before the text test.
+    if head.contains(&0) {
+        return None;
+    }
+    let text = String::from_utf8_lossy(head);
+    let word = text.split_whitespace().next()?;
+    let carmen = word.starts_with('#')
+        || (word.starts_with(|c: char| c.is_ascii_uppercase())
+            && word.chars().all(|c| c.is_ascii_uppercase() || c.is_ascii_digit() || c == '_'));
+    carmen.then_some(Format::Carmen)
+}
+
+/// Reads the log at `path` with `options`: gunzipped when it starts with the gzip magic bytes, the reader
+/// chosen by the file's extension, else by its first bytes; a format no reader knows is refused, naming the
+/// file.
+pub fn read_log(path: &Path, options: &ReadOptions) -> Result<SensorLog, LogError> {
+    let io = |cause| LogError::Io { path: path.to_path_buf(), cause };
+    let mut file = std::fs::File::open(path).map_err(io)?;
+    let mut magic = [0u8; 2];
+    let n = file.read(&mut magic).map_err(io)?;
+    let file = std::fs::File::open(path).map_err(io)?;
+    let mut reader: Box<dyn BufRead> = if n == 2 && magic == GZIP_MAGIC {
+        Box::new(BufReader::new(flate2::read::MultiGzDecoder::new(file)))
+    } else {
+        Box::new(BufReader::new(file))
+    };
+    let format = match format_by_extension(path) {
+        Some(format) => format,
+        None => {
+            let head = reader.fill_buf().map_err(|cause| match cause.kind() {
+                std::io::ErrorKind::UnexpectedEof => LogError::Truncated { path: path.to_path_buf(), line: 0 },
+                _ => LogError::Io { path: path.to_path_buf(), cause },
+            })?;
+            format_by_content(head).ok_or_else(|| LogError::UnknownFormat { path: path.to_path_buf() })?
+        }
+    };
+    match format {
+        Format::Carmen => carmen::parse(reader, path, options),
+    }
+}
+
+/// The log's name for displays and recordings: its file name without `.gz`, `.clf` and `.log`.
+pub fn log_name(path: &Path) -> String {
+    let name = path.file_name().map_or_else(|| "log".to_string(), |n| n.to_string_lossy().into_owned());
+    name.trim_end_matches(".gz").trim_end_matches(".clf").trim_end_matches(".log").to_string()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::io::Write;
+
+    const LOG: &str = "# CARMEN Logfile\nODOM 0 0 0 0 0 0 1.0 h 1\nFLASER 2 1.0 2.0 0 0 0 0 0 0 1.5 h 1\n";
+
+    #[test]
+    fn the_reader_is_chosen_by_magic_bytes_or_extension() {
+        let dir = tempfile::tempdir().unwrap();
+        // A gzipped CARMEN log named .txt: gunzipped by its magic, told CARMEN by its first line.
+        let p = dir.path().join("log.txt");
+        let mut enc = flate2::write::GzEncoder::new(std::fs::File::create(&p).unwrap(), flate2::Compression::fast());
+        enc.write_all(LOG.as_bytes()).unwrap();
+        enc.finish().unwrap();
+        let log = read_log(&p, &ReadOptions::default()).unwrap();
+        assert_eq!((log.scans.len(), log.odometry.len()), (1, 1));
+        // Named .clf, a log is CARMEN whatever its first line.
+        let p = dir.path().join("empty.clf");
+        std::fs::write(&p, "").unwrap();
+        assert_eq!(read_log(&p, &ReadOptions::default()).unwrap().scans.len(), 0);
+        assert_eq!(format_by_extension(Path::new("a.LOG.gz")), Some(Format::Carmen));
+        assert_eq!(format_by_extension(Path::new("a.bag")), None);
+    }
+
+    #[test]
+    fn an_unknown_format_is_refused_naming_the_file() {
+        let dir = tempfile::tempdir().unwrap();
+        for (name, bytes) in [("map.png", &b"\x89PNG\r\n\x1a\n\0\0"[..]), ("notes.txt", b"some words\n"), ("e", b"")] {
+            let p = dir.path().join(name);
+            std::fs::write(&p, bytes).unwrap();
+            let e = read_log(&p, &ReadOptions::default()).unwrap_err();
+            assert!(matches!(e, LogError::UnknownFormat { .. }), "{name}: {e}");
+            assert!(e.to_string().starts_with(&format!("{}: not a log format", p.display())), "{e}");
+        }
+    }
+
+    #[test]
+    fn a_log_is_named_by_its_file_without_log_extensions() {
+        assert_eq!(log_name(Path::new("data/aces.clf.gz")), "aces");
+        assert_eq!(log_name(Path::new("fr079-corrected.log")), "fr079-corrected");
+        assert_eq!(log_name(Path::new("run.txt")), "run.txt");
+        assert_eq!(log_name(Path::new("/")), "log");
+    }
+}
