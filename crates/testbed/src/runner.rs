@@ -6,10 +6,7 @@ use crate::report::{MergeResult, RobotReport, RunReport};
 use crate::scenario::{ControllerKind, MergeWhen, RobotSetup, Scenario};
 use mrslam_core::map_io::{self, MapIoError};
 use mrslam_core::{CellTraversal, LaserScan, OccupancyGrid, Odometry, Pose2, Xyt};
-use mrslam_merge::{
-    Algorithm, Cascade, CorrelativeMerger, CorrelativeParams, MatchParams, MergeOutcome, MergeParams, Merger,
-    RmapMerger, RmapParams, SiftMerger, SiftMergerParams, merge,
-};
+use mrslam_merge::{Algorithm, MergeOutcome, MergeParams, MergerConfig, merge};
 use mrslam_sim::Obstacle;
 use mrslam_sim::{RobotId, Sim, SimConfig, SimError, StepEvents};
 use mrslam_slam::{Rbpf, SlamError};
@@ -69,27 +66,17 @@ pub struct RunOutput {
     pub paths: BTreeMap<String, Vec<Pose2>>,
 }
 
-/// Builds `algorithm`'s merger with the scenario's merge settings, its random draws seeded by the scenario's seed.
-pub fn merger_for(algorithm: Algorithm, scenario: &Scenario) -> Box<dyn Merger> {
+/// `algorithm`'s merger settings from the scenario's merge settings, its random draws seeded by the scenario's seed.
+pub fn merger_for(algorithm: Algorithm, scenario: &Scenario) -> MergerConfig {
     let m = &scenario.merge;
-    let mut sift = SiftMergerParams {
+    MergerConfig {
         model: m.model,
         encoding: m.encoding,
-        matching: MatchParams { ratio: m.ratio, candidates: m.candidates, ..MatchParams::default() },
+        ratio: m.ratio,
+        candidates: m.candidates,
         hypotheses: m.hypotheses,
         wall_dilation: m.wall_dilation,
-        ..SiftMergerParams::default()
-    };
-    sift.ransac.seed = scenario.seed;
-    match algorithm {
-        Algorithm::Sift => Box::new(SiftMerger::new(sift)),
-        Algorithm::Rmap => {
-            let mut p = RmapParams::default();
-            p.orient.seed = scenario.seed;
-            Box::new(RmapMerger::new(p))
-        }
-        Algorithm::Correlative => Box::new(CorrelativeMerger::default()),
-        Algorithm::Cascade => Box::new(Cascade::new(sift, CorrelativeParams::default())),
+        ..MergerConfig::new(algorithm, scenario.seed)
     }
 }
 
@@ -429,7 +416,7 @@ fn merge_maps(
     let mut merges = Vec::new();
     let mut results = Vec::new();
     for &algorithm in algorithms {
-        let merger = merger_for(algorithm, scenario);
+        let merger = merger_for(algorithm, scenario).build();
         let out = merge(merger.as_ref(), &evaluated.maps[host], &evaluated.maps[other], &MergeParams::default());
         let err = out.report.transform.map(|t| transform_error(&t.to_pose(), &true_t));
         let err_at_end = out.report.transform.map(|t| transform_error(&t.to_pose(), &end_t));
@@ -670,10 +657,14 @@ mod tests {
     }
 
     #[test]
-    fn every_algorithm_gets_its_own_merger() {
-        let s = two_rooms();
+    fn a_scenarios_merger_follows_its_settings_and_seed() {
+        let mut s = two_rooms();
+        s.seed = 17;
+        s.merge.hypotheses = 3;
         for a in Algorithm::ALL {
-            assert_eq!(merger_for(a, &s).name(), a.name());
+            let c = merger_for(a, &s);
+            assert_eq!((c.algorithm, c.seed, c.hypotheses), (a, 17, 3));
+            assert_eq!(c.build().name(), a.name());
         }
     }
 }
