@@ -9,7 +9,7 @@ use mrslam_core::map_io::{self, write_file_atomic};
 use mrslam_core::relations;
 use mrslam_merge::Encoding;
 use mrslam_slam::Preset;
-use mrslam_studies::journal::StudyParams;
+use mrslam_studies::journal::{StudyParams, fingerprint};
 use mrslam_studies::logs::{self, PairRow, ScoreParams};
 use mrslam_studies::results::TrialRow;
 use mrslam_studies::summary::summarise;
