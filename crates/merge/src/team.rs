@@ -52,12 +52,7 @@ impl<'m> MapGraph<'m> {
 
     /// Replaces map `id` by its `version`; its pairs are merged again at the next [`MapGraph::merge`] unless the
     /// version is the one they were merged at.
-    pub fn update(
-        &mut self,
-        id: MapId,
-        map: Cow<'m, OccupancyGrid>,
-        version: u64,
-    ) -> Result<(), UnknownMap> {
+    pub fn update(&mut self, id: MapId, map: Cow<'m, OccupancyGrid>, version: u64) -> Result<(), UnknownMap> {
         let slot = self.maps.get_mut(id).ok_or(UnknownMap(id))?;
         *slot = (map, version);
         Ok(())
