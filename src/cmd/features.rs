@@ -4,7 +4,7 @@ use anyhow::{Context, Result, bail};
 use clap::Args;
 use mrslam_core::map_io;
 use mrslam_core::output::write_file_atomic;
-use mrslam_merge::MapEncoding;
+use mrslam_merge::Encoding;
 use mrslam_merge::MapImage;
 use mrslam_sift::{Features, GrayImage, Sift, SiftParams};
 use std::path::{Path, PathBuf};
@@ -23,8 +23,8 @@ pub struct FeaturesArgs {
     #[arg(long)]
     pub png: Option<PathBuf>,
     /// For a map YAML: `walls` (free and unknown alike, the merger's default) or `paper` (unknown grey).
-    #[arg(long, default_value = "walls", value_parser = ["walls", "paper"])]
-    pub encoding: String,
+    #[arg(long, default_value = "walls", value_parser = super::args::one_of::<Encoding>(Encoding::ALL.map(Encoding::name)))]
+    pub encoding: Encoding,
     /// Do not double the image first (OpenCV doubles it).
     #[arg(long)]
     pub no_upscale: bool,
@@ -43,7 +43,7 @@ pub fn run(args: FeaturesArgs) -> Result<ExitCode> {
     }
     let outputs: Vec<&Path> = [&args.json, &args.png].into_iter().flatten().map(PathBuf::as_path).collect();
     super::paths::check_outputs(&outputs, &[&args.image])?;
-    let (img, what) = load(&args.image, &args.encoding)?;
+    let (img, what) = load(&args.image, args.encoding)?;
     let params = SiftParams { upscale: !args.no_upscale, max_features: args.max_features, ..SiftParams::default() };
     let mut sift = Sift::new(params);
     let t = Instant::now();
@@ -65,12 +65,11 @@ pub fn run(args: FeaturesArgs) -> Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-fn load(path: &Path, encoding: &str) -> Result<(GrayImage, &'static str)> {
+fn load(path: &Path, encoding: Encoding) -> Result<(GrayImage, &'static str)> {
     let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
     if ext == "yaml" || ext == "yml" {
         let grid = super::map::read_yaml_map(path)?;
-        let enc = if encoding == "paper" { MapEncoding::PAPER } else { MapEncoding::WALLS };
-        let img = MapImage::render(&grid, &enc, 8);
+        let img = MapImage::render(&grid, &encoding.levels(), 8);
         let g = GrayImage::new(img.width, img.height, img.pixels).with_context(|| format!("{}", path.display()))?;
         return Ok((g, "map image"));
     }

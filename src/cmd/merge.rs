@@ -2,15 +2,11 @@
 
 use anyhow::{Context, Result, bail};
 use clap::Args;
-use clap::builder::{PossibleValuesParser, TypedValueParser};
 use mrslam_core::OccupancyGrid;
 use mrslam_core::map_io;
 use mrslam_core::output::write_file_atomic;
 use mrslam_merge::MapImage;
-use mrslam_merge::{
-    Algorithm, BoundaryWalls, Cascade, CorrelativeMerger, CorrelativeParams, Evidence, FusionRule, MapEncoding,
-    MatchParams, MergeParams, MergeReport, Merger, Model, RmapMerger, RmapParams, SiftMerger, SiftMergerParams, merge,
-};
+use mrslam_merge::{Evidence, MapEncoding, MergeReport, merge};
 use mrslam_testbed::runner::merge_view;
 use mrslam_viz::pair::record_pair;
 use std::path::{Path, PathBuf};
@@ -33,60 +29,9 @@ pub struct MergeArgs {
     /// Write the merge report (JSON) here, accepted or not.
     #[arg(long)]
     pub report: Option<PathBuf>,
-    /// Merge algorithm: `sift` (the paper's, Alg. 3), `rmap` (Park's R-map baseline, Alg. 1), `correlative`
-    /// (global correlative search by branch and bound) or `cascade` (`sift`, `sift` with every map's boundary as
-    /// walls, then `correlative`: the first answer the gate accepts; the default, chosen by measurement on
-    /// generated plans, cuts of a real map and two robots' SLAM maps: benchmarks/runs/2026-12-02-merge-cascade.md).
-    #[arg(long, default_value = "cascade", value_parser = algorithm_parser())]
-    pub algorithm: Algorithm,
-    /// Transform model: rigid, similarity or homography (the paper's; its rigid part is used).
-    #[arg(long, default_value = "rigid")]
-    pub model: Model,
-    /// Lowe's ratio for descriptor matching, in (0, 1].
-    #[arg(long, default_value_t = 0.75, value_parser = ratio)]
-    pub ratio: f32,
-    /// Keep only mutual nearest-neighbour matches.
-    #[arg(long)]
-    pub mutual: bool,
-    /// Candidates per feature: 1 = nearest neighbour with the ratio test (the paper); k > 1 = the k nearest.
-    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=16))]
-    pub candidates: u32,
-    /// Transforms handed to verification, strongest first (sequential RANSAC); 1 = the paper's single answer.
-    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=16))]
-    pub hypotheses: u32,
-    /// Grow occupied cells by this many cells before SIFT (0 = the map as it is).
-    #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u32).range(0..=4))]
-    pub wall_dilation: u32,
-    /// The verification gate's wall tolerance: a wall of map b meets a wall of map a within this many cells
-    /// (1: the 3x3 neighbourhood, the gate before 2026-12-02; 2 lets the walls of two robots' SLAM runs meet).
-    #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u32).range(0..=4))]
-    pub wall_tolerance: u32,
-    /// Which maps get walls where their free space meets unknown: `unmarked` (maps with almost no occupied
-    /// cells: map_server's light-grey walls, glass), `always` (every map, its own walls kept) or `off` (the maps
-    /// as they are: the paper's merger has no such step; a cascade then skips its `sift+boundary` stage).
-    #[arg(long, default_value = "unmarked", value_parser = boundary_walls_parser())]
-    pub boundary_walls: BoundaryWalls,
-    /// The correlative merger's significance test: its best pose must score this share above every pose clearly
-    /// apart from it (Lowe's ratio test), else the merge is refused as ambiguous, naming the rival; 0 turns the
-    /// test off [default: `AnswerParams::default().min_margin`, 0.15].
-    #[arg(long, value_parser = margin)]
-    pub min_margin: Option<f64>,
-    /// The correlative merger's answer is not checked by the same search the other way round (the other map's
-    /// walls on this one's), as before 2026-12-03; the check refuses answers that are ambiguous that way.
-    #[arg(long)]
-    pub one_way: bool,
-    /// Map-to-image encoding: `walls` (free and unknown alike) or `paper` (unknown grey).
-    #[arg(long, default_value = "walls", value_parser = ["walls", "paper"])]
-    pub encoding: String,
-    /// How aligned cells combine: log-odds-sum or occupied-free-unknown.
-    #[arg(long, default_value = "log-odds-sum")]
-    pub fusion: FusionRule,
-    /// Skip the verification gate and accept whatever the algorithm answers.
-    #[arg(long)]
-    pub no_verify: bool,
-    /// Seed of the robust estimator.
-    #[arg(long, default_value_t = 0)]
-    pub seed: u64,
+    /// The merger and the pipeline around it.
+    #[command(flatten)]
+    pub merger: super::merger_args::MergerArgs,
     /// Draw both maps side by side with the inlier matches (PNG).
     #[arg(long)]
     pub matches_png: Option<PathBuf>,
@@ -95,32 +40,18 @@ pub struct MergeArgs {
     pub viz: super::viz::VizArgs,
 }
 
-/// Reads `--ratio`: a number in (0, 1] (a ratio above 1 accepts every match).
-fn ratio(s: &str) -> Result<f32, String> {
-    match s.parse::<f32>() {
-        Ok(r) if r > 0.0 && r <= 1.0 => Ok(r),
-        Ok(r) => Err(format!("{r} is outside (0, 1]")),
-        Err(e) => Err(e.to_string()),
+/// Fails on the flags that only make sense for two maps (the match drawing, the rerun recording).
+fn refuse_pair_only_flags(args: &MergeArgs) -> Result<()> {
+    let n = 2 + args.more.len();
+    if args.matches_png.is_some() {
+        bail!("--matches-png draws the matches of two maps, and {n} maps were given; merge a pair to draw it");
     }
-}
-
-/// Reads `--min-margin`: a number in [0, 1).
-fn margin(s: &str) -> Result<f64, String> {
-    match s.parse::<f64>() {
-        Ok(m) if (0.0..1.0).contains(&m) => Ok(m),
-        Ok(m) => Err(format!("{m} is outside [0, 1)")),
-        Err(e) => Err(e.to_string()),
+    if !args.viz.targets()?.is_empty() {
+        bail!(
+            "--rrd, --spawn and --connect record the merge of two maps, and {n} maps were given; merge a pair to record it"
+        );
     }
-}
-
-/// Reads `--algorithm`: a name of [`Algorithm::ALL`], each listed in `--help`.
-fn algorithm_parser() -> impl TypedValueParser<Value = Algorithm> {
-    PossibleValuesParser::new(Algorithm::ALL.map(Algorithm::name)).try_map(|s| s.parse::<Algorithm>())
-}
-
-/// Reads `--boundary-walls`: a name of [`BoundaryWalls::ALL`].
-fn boundary_walls_parser() -> impl TypedValueParser<Value = BoundaryWalls> {
-    PossibleValuesParser::new(BoundaryWalls::ALL.map(BoundaryWalls::name)).try_map(|s| s.parse::<BoundaryWalls>())
+    Ok(())
 }
 
 /// Runs `mrslam merge`.
@@ -140,52 +71,20 @@ pub fn run(args: MergeArgs) -> Result<ExitCode> {
     let inputs: Vec<&Path> = [&args.a, &args.b].into_iter().chain(&args.more).map(PathBuf::as_path).collect();
     super::paths::check_outputs(&outputs, &inputs)?;
     if !args.more.is_empty() {
-        super::merge_many::refuse_pair_only_flags(&args)?;
+        refuse_pair_only_flags(&args)?;
     }
     let a = super::map::read_yaml_map(&args.a)?;
     let b = super::map::read_yaml_map(&args.b)?;
     let (name_a, name_b) = pair_names(&args.a, &args.b);
-    let recording_id = format!("merge-{name_a}-{name_b}-{}-seed{}", args.algorithm, args.seed);
-    let mut viz = args.viz.open(&recording_id, &format!("merge {name_a} + {name_b} ({})", args.algorithm))?;
-    let mut params = SiftMergerParams {
-        model: args.model,
-        matching: MatchParams {
-            ratio: args.ratio,
-            mutual: args.mutual,
-            parallel: true,
-            candidates: args.candidates as usize,
-        },
-        wall_dilation: args.wall_dilation as usize,
-        hypotheses: args.hypotheses as usize,
-        encoding: if args.encoding == "paper" { MapEncoding::PAPER } else { MapEncoding::WALLS },
-        // One merge has the machine to itself: the two maps' features on two threads (the studies, which run
-        // merges side by side, keep one thread per merge).
-        parallel: true,
-        ..Default::default()
-    };
-    params.ransac.seed = args.seed;
-    let mut correlative = CorrelativeParams::default();
-    correlative.answer.min_margin = args.min_margin.unwrap_or(correlative.answer.min_margin);
-    correlative.answer.cross_check = !args.one_way;
-    let merger: Box<dyn Merger> = match args.algorithm {
-        Algorithm::Sift => Box::new(SiftMerger::new(params)),
-        Algorithm::Rmap => {
-            let mut rp = RmapParams::default();
-            rp.orient.seed = args.seed;
-            Box::new(RmapMerger::new(rp))
-        }
-        Algorithm::Correlative => Box::new(CorrelativeMerger::new(correlative)),
-        Algorithm::Cascade => Box::new(Cascade::new(params, correlative)),
-    };
-    let mut mp = MergeParams {
-        verify_enabled: !args.no_verify,
-        fusion: args.fusion,
-        boundary_walls: args.boundary_walls,
-        ..MergeParams::default()
-    };
-    mp.verify.wall_tolerance_cells = args.wall_tolerance as usize;
+    let (algorithm, seed) = (args.merger.algorithm, args.merger.seed);
+    let recording_id = format!("merge-{name_a}-{name_b}-{algorithm}-seed{seed}");
+    let mut viz = args.viz.open(&recording_id, &format!("merge {name_a} + {name_b} ({algorithm})"))?;
+    let merger = args.merger.config().build();
+    let mp = args.merger.params();
     if !args.more.is_empty() {
-        return super::merge_many::run(&args, vec![a, b], merger.as_ref(), &mp);
+        let files: Vec<&Path> = [&args.a, &args.b].into_iter().chain(&args.more).map(PathBuf::as_path).collect();
+        let outputs = super::merge_many::Outputs { report: args.report.as_deref(), map: args.output.as_deref() };
+        return super::merge_many::run(&files, vec![a, b], merger.as_ref(), &mp, outputs);
     }
     let out = merge(merger.as_ref(), &a, &b, &mp);
     if let Some(p) = &args.report {

@@ -1,45 +1,43 @@
 //! `mrslam merge A.yaml B.yaml C.yaml ...`: three or more maps merged along a spanning tree of the most
 //! confident accepted pairs, each placed in the first map's frame.
 
-use super::merge::MergeArgs;
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 use mrslam_core::OccupancyGrid;
 use mrslam_core::Xyt;
 use mrslam_core::map_io;
 use mrslam_core::output::write_file_atomic;
 use mrslam_merge::{MergeParams, Merger, MultiReport, merge_many};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::ExitCode;
 
-/// Fails on the flags that only make sense for two maps (the match drawing, the rerun recording).
-pub fn refuse_pair_only_flags(args: &MergeArgs) -> Result<()> {
-    let n = 2 + args.more.len();
-    if args.matches_png.is_some() {
-        bail!("--matches-png draws the matches of two maps, and {n} maps were given; merge a pair to draw it");
-    }
-    if !args.viz.targets()?.is_empty() {
-        bail!(
-            "--rrd, --spawn and --connect record the merge of two maps, and {n} maps were given; merge a pair to record it"
-        );
-    }
-    Ok(())
+/// Where the N-map merge's results go.
+pub struct Outputs<'a> {
+    /// The JSON report (`--report`).
+    pub report: Option<&'a Path>,
+    /// The merged map (`--output`).
+    pub map: Option<&'a Path>,
 }
 
-/// Runs the N-map merge: `maps` holds the first two maps, read already; the rest are read from `args.more`.
-pub fn run(args: &MergeArgs, mut maps: Vec<OccupancyGrid>, merger: &dyn Merger, mp: &MergeParams) -> Result<ExitCode> {
-    for p in &args.more {
+/// Runs the N-map merge of the maps in `files`: `maps` holds the first ones, read already; the rest are read here.
+pub fn run(
+    files: &[&Path],
+    mut maps: Vec<OccupancyGrid>,
+    merger: &dyn Merger,
+    mp: &MergeParams,
+    to: Outputs,
+) -> Result<ExitCode> {
+    for p in &files[maps.len()..] {
         maps.push(super::map::read_yaml_map(p)?);
     }
-    let files: Vec<&PathBuf> = [&args.a, &args.b].into_iter().chain(&args.more).collect();
     let out = merge_many(merger, &maps, mp);
-    if let Some(p) = &args.report {
+    if let Some(p) = to.report {
         let files = files.iter().map(|f| f.display().to_string()).collect();
         let bytes =
             serde_json::to_vec_pretty(&Report { files, report: &out.report }).context("serialising the report")?;
         write_file_atomic(p, &bytes)?;
     }
-    print!("{}", summary(&out.report, &files));
-    match (&out.merged, &args.output) {
+    print!("{}", summary(&out.report, files));
+    match (&out.merged, to.map) {
         (Some(g), Some(path)) => {
             map_io::write_ros_map_with_preview(g, path)?;
             let joined = out.report.maps - out.report.not_connected.len();
@@ -76,7 +74,7 @@ fn xyt(t: &Xyt) -> String {
 
 /// The human summary of an N-map merge: a line per pair, the tree, each map's transform, the maps left out, the
 /// accepted pairs the tree contradicts.
-pub fn summary(r: &MultiReport, files: &[&PathBuf]) -> String {
+pub fn summary(r: &MultiReport, files: &[&Path]) -> String {
     let name = |i: usize| files.get(i).map_or_else(|| format!("map {i}"), |f| short(f));
     let joined = r.maps - r.not_connected.len();
     let mut s =

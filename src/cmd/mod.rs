@@ -1,11 +1,13 @@
 //! One module per subcommand.
 
+pub mod args;
 pub mod eval;
 pub mod features;
 pub mod log;
 pub mod map;
 pub mod merge;
 pub mod merge_many;
+pub mod merger_args;
 pub mod paths;
 pub mod replay_plot;
 pub mod run;

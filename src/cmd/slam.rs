@@ -169,12 +169,7 @@ pub fn run(args: SlamArgs) -> Result<ExitCode> {
     if let Some(v) = args.max_urange {
         params.map.max_urange = v;
     }
-    for kv in &args.set {
-        let Some((name, value)) = kv.split_once('=') else {
-            bail!("--set {kv}: expected NAME=VALUE");
-        };
-        params.set(name.trim(), value).map_err(|e| anyhow::anyhow!("--set {kv}: {e}"))?;
-    }
+    super::args::set_each("--set", &args.set, |name, value| params.set(name, value))?;
     params.validate().map_err(|e| anyhow::anyhow!("slam parameters: {e}"))?;
     // Read the relations before the long work, so that a bad file costs nothing.
     let rels = match &args.relations {

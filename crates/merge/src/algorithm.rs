@@ -12,7 +12,8 @@ use std::str::FromStr;
 /// assert_eq!(a.to_string(), "rmap");
 /// assert!("magic".parse::<Algorithm>().unwrap_err().to_string().contains("sift, rmap, correlative, cascade"));
 /// ```
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
 pub enum Algorithm {
     /// `sift`: the paper's SIFT merger (Algorithm 3), [`crate::SiftMerger`].
     Sift,

@@ -12,9 +12,14 @@
 //! Each stage is a second chance for a wrong pose too, so the order and the stages were chosen by measuring false
 //! merges on non-overlapping pairs alongside the successes (benchmarks/runs/2026-12-02-merge-cascade.md).
 
+use crate::alignment::{Alignment, NoAlignment};
 use crate::boundary_walls::{Boundary, BoundaryWalls};
-use crate::merger::{Alignment, MergeOutcome, MergeParams, Merger, NoAlignment, merge_bounded, refused};
-use crate::{CorrelativeMerger, CorrelativeParams, SiftMerger, SiftMergerParams};
+use crate::correlative::{CorrelativeMerger, CorrelativeParams};
+use crate::merge_params::MergeParams;
+use crate::merger::{Merger, merge_bounded};
+use crate::report::{MergeOutcome, refused};
+use crate::sift_merger::{SiftMerger, SiftMergerParams};
+use crate::timing::ms;
 use mrslam_core::OccupancyGrid;
 use std::collections::BTreeMap;
 use std::time::Instant;
@@ -103,12 +108,13 @@ impl Merger for Cascade {
         }))
     }
 
-    fn cascade(&self) -> Option<&Cascade> {
-        Some(self)
+    /// Each stage through the pipeline in turn: [`merge_cascade`].
+    fn merge(&self, a: &OccupancyGrid, b: &OccupancyGrid, p: &MergeParams) -> MergeOutcome {
+        merge_cascade(self, a, b, p)
     }
 }
 
-/// Runs the cascade's stages in turn through [`merge_one`]; the first accepted outcome, else the last refusal
+/// Runs the cascade's stages in turn through the pipeline; the first accepted outcome, else the last refusal
 /// with every stage's reason. Timings are prefixed by the stage (`correlative/search`), the report's `stage`
 /// names the stage that decided.
 pub(crate) fn merge_cascade(c: &Cascade, a: &OccupancyGrid, b: &OccupancyGrid, p: &MergeParams) -> MergeOutcome {
@@ -133,14 +139,14 @@ pub(crate) fn merge_cascade(c: &Cascade, a: &OccupancyGrid, b: &OccupancyGrid, p
         last = Some(out);
     }
     let Some(mut out) = last else {
-        return refused(c, NO_STAGES.into(), 0, BTreeMap::new(), start);
+        return refused(c.name(), NO_STAGES.into(), 0, BTreeMap::new(), start);
     };
     if !out.report.accepted {
         out.report.reason = Some(reasons.join("; "));
     }
     out.report.algorithm = c.name().to_string();
     out.report.timings_ms = timings;
-    out.report.time_ms = start.elapsed().as_secs_f64() * 1e3;
+    out.report.time_ms = ms(start);
     out
 }
 
@@ -270,8 +276,21 @@ mod tests {
     }
 
     #[test]
-    fn the_default_cascade_names_its_stages_in_order() {
-        let names: Vec<_> = Cascade::default().stages.iter().map(|s| s.name).collect();
-        assert_eq!(names, ["sift", "sift+boundary", "correlative"]);
+    fn the_default_cascade_tries_sift_then_boundary_walls_then_the_correlative_search() {
+        use crate::floorplan::{FloorplanParams, generate};
+        use crate::pairs::{PairSpec, cut_pair};
+        // A pair the paper's merger takes is merged by the first stage.
+        let plan = generate(1, &FloorplanParams::default());
+        let pair = cut_pair(&plan, &PairSpec { overlap: 0.4, ..Default::default() }, 3);
+        let out = crate::merge(&Cascade::default(), &pair.a, &pair.b, &MergeParams::default());
+        assert!(out.report.accepted, "{:?}", out.report.reason);
+        assert_eq!(out.report.stage.as_deref(), Some("sift"));
+        // A pair nothing can merge (the room and a small patch of free space) is refused by every stage, in order.
+        let mut patch = OccupancyGrid::new(20, 20, 0.05, pose(0.0, 0.0, 0.0)).unwrap();
+        patch.cells_mut().fill(-2.0);
+        let reason =
+            crate::merge(&Cascade::default(), &room(true), &patch, &MergeParams::default()).report.reason.unwrap();
+        let at = |stage: &str| reason.find(&format!("{stage}: ")).unwrap_or_else(|| panic!("{stage}: {reason}"));
+        assert!(at("sift") < at("sift+boundary") && at("sift+boundary") < at("correlative"), "{reason}");
     }
 }

@@ -23,6 +23,18 @@ pub enum Model {
 }
 
 impl Model {
+    /// Every model, as the command line lists them.
+    pub const ALL: [Model; 3] = [Model::Rigid, Model::Similarity, Model::Homography];
+
+    /// The name: `rigid`, `similarity` or `homography`.
+    pub const fn name(self) -> &'static str {
+        match self {
+            Model::Rigid => "rigid",
+            Model::Similarity => "similarity",
+            Model::Homography => "homography",
+        }
+    }
+
     /// Points needed for one hypothesis.
     pub fn sample_size(self) -> usize {
         match self {
@@ -35,12 +47,10 @@ impl Model {
 impl std::str::FromStr for Model {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        match s {
-            "rigid" => Ok(Model::Rigid),
-            "similarity" => Ok(Model::Similarity),
-            "homography" => Ok(Model::Homography),
-            _ => Err(format!("unknown model `{s}` (expected rigid, similarity or homography)")),
-        }
+        Model::ALL
+            .into_iter()
+            .find(|m| m.name() == s)
+            .ok_or_else(|| format!("unknown model `{s}` (expected rigid, similarity or homography)"))
     }
 }
 

@@ -15,14 +15,27 @@ pub enum FusionRule {
     OccupiedFreeUnknown,
 }
 
+impl FusionRule {
+    /// Every rule, as the command line lists them.
+    pub const ALL: [FusionRule; 2] = [FusionRule::LogOddsSum, FusionRule::OccupiedFreeUnknown];
+
+    /// The name: `log-odds-sum` or `occupied-free-unknown`.
+    pub const fn name(self) -> &'static str {
+        match self {
+            FusionRule::LogOddsSum => "log-odds-sum",
+            FusionRule::OccupiedFreeUnknown => "occupied-free-unknown",
+        }
+    }
+}
+
 impl std::str::FromStr for FusionRule {
     type Err = String;
+    /// Reads a name of [`FusionRule::ALL`], or the same with underscores (as JSON writes it).
     fn from_str(s: &str) -> Result<Self, String> {
-        match s {
-            "log-odds-sum" | "log_odds_sum" => Ok(FusionRule::LogOddsSum),
-            "occupied-free-unknown" | "occupied_free_unknown" => Ok(FusionRule::OccupiedFreeUnknown),
-            _ => Err(format!("unknown fusion rule `{s}` (expected log-odds-sum or occupied-free-unknown)")),
-        }
+        FusionRule::ALL
+            .into_iter()
+            .find(|r| r.name() == s || r.name().replace('-', "_") == s)
+            .ok_or_else(|| format!("unknown fusion rule `{s}` (expected log-odds-sum or occupied-free-unknown)"))
     }
 }
 

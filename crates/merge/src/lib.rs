@@ -1,9 +1,10 @@
 //! mrslam-merge: occupancy-grid map merging with unknown relative pose.
 //!
 //! The paper's SIFT merger ([`SiftMerger`], Algorithm 3), its R-map baseline ([`RmapMerger`], Algorithm 1)
-//! and a global correlative search ([`CorrelativeMerger`]) behind the [`Merger`] interface, named by [`Algorithm`], a verification
-//! gate that rejects merges the maps themselves contradict (`verify`), fusion into one grid (`fuse`),
-//! N maps at once along a spanning tree of the most confident pairs (`multi`),
+//! and a global correlative search ([`CorrelativeMerger`]) behind the [`Merger`] interface, named by [`Algorithm`]
+//! and built in one place from plain settings ([`MergerConfig`]), a verification gate that rejects merges the maps
+//! themselves contradict (`verify`, `gate`), fusion into one grid (`fuse`), a team's maps as a graph merged
+//! incrementally along a spanning tree of the most confident pairs ([`MapGraph`]; [`merge_many`] at once),
 //! and the generators evaluation needs: procedural floor plans ([`floorplan`]) and map pairs cut with a
 //! known overlap and a known transform ([`pairs`]).
 //!
@@ -28,14 +29,18 @@
 #![deny(missing_docs)]
 
 mod algorithm;
+mod alignment;
 pub mod boundary_walls;
 mod cascade;
+mod config;
 mod correlative;
 mod estimate;
 pub mod floorplan;
 mod fuse;
+mod gate;
 mod map_image;
 mod matching;
+mod merge_params;
 mod merger;
 mod multi;
 pub mod pairs;
@@ -44,22 +49,28 @@ mod report;
 pub mod resample;
 mod rmap;
 mod sift_merger;
+mod team;
+mod timing;
 mod verify;
 
 pub use algorithm::{Algorithm, UnknownAlgorithm};
+pub use alignment::{Alignment, Evidence, Hypothesis, NoAlignment};
 pub use boundary_walls::BoundaryWalls;
 pub use cascade::{Cascade, Stage};
+pub use config::MergerConfig;
 pub use correlative::{AnswerParams, CorrelativeMerger, CorrelativeParams, FallbackParams, FineParams, SearchParams};
 pub use estimate::{Model, RansacParams};
 pub use fuse::FusionRule;
-pub use map_image::{MapEncoding, MapImage};
+pub use map_image::{Encoding, MapEncoding, MapImage};
 pub use matching::MatchParams;
-pub use merger::{Alignment, Evidence, MergeOutcome, MergeParams, Merger, NoAlignment, merge};
-pub use multi::{DISAGREE_DEG, DISAGREE_M, Disagreement, MultiOutcome, MultiReport, PairReport, TreeEdge, merge_many};
+pub use merge_params::MergeParams;
+pub use merger::{Merger, merge};
+pub use multi::{DISAGREE_DEG, DISAGREE_M, Disagreement, MultiOutcome, MultiReport, PairReport, TreeEdge};
 pub use refine::RefineParams;
-pub use report::MergeReport;
+pub use report::{MergeOutcome, MergeReport};
 pub use rmap::{CoverRule, OrientParams, RmapMerger, RmapParams, RmapResult, TriangleMatch, TriangleParams};
 pub use sift_merger::{SiftMerger, SiftMergerParams};
+pub use team::{MapGraph, MapId, UnknownMap, merge_many};
 pub use verify::{Agreement, VerifyParams, agreement, agreement_within};
 
 /// Internals public only for the crate's tests and benches and the development probes (`dev/` in the

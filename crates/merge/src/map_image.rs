@@ -33,6 +33,54 @@ impl MapEncoding {
     }
 }
 
+/// A named [`MapEncoding`], as scenario files, studies and the command line choose one.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Encoding {
+    /// [`MapEncoding::WALLS`].
+    #[default]
+    Walls,
+    /// [`MapEncoding::PAPER`].
+    Paper,
+}
+
+impl Encoding {
+    /// Every encoding, as the command line lists them.
+    pub const ALL: [Encoding; 2] = [Encoding::Walls, Encoding::Paper];
+
+    /// The name: `walls` or `paper`.
+    pub const fn name(self) -> &'static str {
+        match self {
+            Encoding::Walls => "walls",
+            Encoding::Paper => "paper",
+        }
+    }
+
+    /// Its grey levels.
+    pub const fn levels(self) -> MapEncoding {
+        match self {
+            Encoding::Walls => MapEncoding::WALLS,
+            Encoding::Paper => MapEncoding::PAPER,
+        }
+    }
+}
+
+impl std::fmt::Display for Encoding {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for Encoding {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        Encoding::ALL
+            .into_iter()
+            .find(|e| e.name() == s)
+            .ok_or_else(|| format!("unknown encoding `{s}` (expected walls or paper)"))
+    }
+}
+
 impl Default for MapEncoding {
     /// [`MapEncoding::WALLS`]: measured better than the paper's on cut pairs (see BENCHMARKS.md, merge).
     fn default() -> Self {

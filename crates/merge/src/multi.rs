@@ -1,13 +1,12 @@
-//! Merging N maps at once: every pair through [`merge`], a maximum spanning tree of the accepted pairs by
-//! confidence (m-explore's approach), each map's transform into map 0's frame composed along the tree, and
-//! the maps joined to map 0 fused into one grid in its frame.
+//! N maps from their pairs' merges: a maximum spanning tree of the accepted pairs by confidence (m-explore's
+//! approach), each map's transform into map 0's frame composed along the tree, the accepted pairs the tree
+//! contradicts, and the maps joined to map 0 fused into one grid in its frame.
 
-use crate::fuse::fuse;
-use crate::merger::{MergeParams, Merger, merge};
+use crate::fuse::{FusionRule, fuse};
 use crate::report::MergeReport;
+use crate::timing::ms;
 use mrslam_core::Xyt;
 use mrslam_core::{OccupancyGrid, Pose2};
-use rayon::prelude::*;
 use std::time::Instant;
 
 /// One pair's merge: `report.transform` is `T_a_b` (points of map `b` into map `a`'s frame).
@@ -56,7 +55,7 @@ pub const DISAGREE_M: f64 = 1.0;
 /// Or beyond this rotation, degrees (correct pairs: below 1°; wrong ones seen: 90° and 180°).
 pub const DISAGREE_DEG: f64 = 5.0;
 
-/// What [`merge_many`] reports (also the JSON `mrslam merge` writes for three or more maps).
+/// What [`crate::merge_many`] reports (also the JSON `mrslam merge` writes for three or more maps).
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct MultiReport {
     /// Algorithm name.
@@ -87,7 +86,7 @@ impl MultiReport {
     }
 }
 
-/// Everything [`merge_many`] produced.
+/// Everything [`crate::merge_many`] produced.
 #[derive(Debug, Clone)]
 pub struct MultiOutcome {
     /// The report.
@@ -123,15 +122,27 @@ impl UnionFind {
     }
 }
 
-/// An accepted pair as a weighted edge: (pair index, a, b, confidence, `T_a_b`).
-type Edge = (usize, usize, usize, f64, Pose2);
+/// An accepted pair as a weighted edge of the graph of maps.
+#[derive(Debug, Clone, Copy)]
+struct Edge {
+    /// Index of the pair in [`MultiReport::pairs`].
+    pair: usize,
+    /// The pair's first map.
+    a: usize,
+    /// The pair's second map.
+    b: usize,
+    /// The pair's confidence (the edge's weight).
+    confidence: f64,
+    /// `T_a_b`: points of b's frame into a's.
+    t_a_b: Pose2,
+}
 
 /// Kruskal's maximum spanning forest: the most confident edges first, ties by pair index.
 fn spanning_forest(n: usize, edges: &[Edge]) -> Vec<Edge> {
-    let mut order: Vec<&Edge> = edges.iter().filter(|e| e.1 < n && e.2 < n).collect();
-    order.sort_by(|x, y| y.3.total_cmp(&x.3).then(x.0.cmp(&y.0)));
+    let mut order: Vec<&Edge> = edges.iter().filter(|e| e.a < n && e.b < n).collect();
+    order.sort_by(|x, y| y.confidence.total_cmp(&x.confidence).then(x.pair.cmp(&y.pair)));
     let mut uf = UnionFind::new(n);
-    order.into_iter().filter(|e| uf.union(e.1, e.2)).cloned().collect()
+    order.into_iter().filter(|e| uf.union(e.a, e.b)).cloned().collect()
 }
 
 /// The forest's components (sorted, by smallest member) and its edges oriented breadth first from each
@@ -139,8 +150,8 @@ fn spanning_forest(n: usize, edges: &[Edge]) -> Vec<Edge> {
 fn orient(n: usize, forest: &[Edge]) -> (Vec<Vec<usize>>, Vec<TreeEdge>, Vec<Pose2>) {
     let mut adjacent: Vec<Vec<&Edge>> = vec![Vec::new(); n];
     for e in forest {
-        adjacent[e.1].push(e);
-        adjacent[e.2].push(e);
+        adjacent[e.a].push(e);
+        adjacent[e.b].push(e);
     }
     let mut seen = vec![false; n];
     let mut to_root = vec![Pose2::identity(); n];
@@ -155,7 +166,7 @@ fn orient(n: usize, forest: &[Edge]) -> (Vec<Vec<usize>>, Vec<TreeEdge>, Vec<Pos
         while k < queue.len() {
             let parent = queue[k];
             k += 1;
-            for &&(pair, a, b, confidence, t_a_b) in &adjacent[parent] {
+            for &&Edge { pair, a, b, confidence, t_a_b } in &adjacent[parent] {
                 let (child, t_parent_child) = if a == parent { (b, t_a_b) } else { (a, t_a_b.inverse()) };
                 if seen[child] {
                     continue;
@@ -178,9 +189,9 @@ fn disagreements(edges: &[Edge], forest: &[Edge], components: &[Vec<usize>], to_
     let component = |i: usize| components.iter().position(|c| c.contains(&i));
     edges
         .iter()
-        .filter(|e| !forest.iter().any(|f| f.0 == e.0))
-        .filter(|e| component(e.1).is_some() && component(e.1) == component(e.2))
-        .filter_map(|&(pair, a, b, _, t_a_b)| {
+        .filter(|e| !forest.iter().any(|f| f.pair == e.pair))
+        .filter(|e| component(e.a).is_some() && component(e.a) == component(e.b))
+        .filter_map(|&Edge { pair, a, b, t_a_b, .. }| {
             let chain = to_root[a].inverse() * to_root[b];
             let d = chain.inverse() * t_a_b;
             let (translation_m, rotation_deg) = (d.translation.vector.norm(), d.rotation.angle().abs().to_degrees());
@@ -193,24 +204,26 @@ fn disagreements(edges: &[Edge], forest: &[Edge], components: &[Vec<usize>], to_
         .collect()
 }
 
-/// Merges N maps: [`merge`] on every pair (in parallel, reported in pair order), a maximum spanning tree of
-/// the accepted pairs by confidence rooted at map 0, each map's transform into map 0's frame along the tree,
-/// and the maps joined to map 0 fused one by one (tree order) onto map 0 with `params.fusion`.
-///
-/// Maps of different resolution are handled as [`merge`] handles them; the fused grid has map 0's.
-pub fn merge_many(merger: &dyn Merger, maps: &[OccupancyGrid], params: &MergeParams) -> MultiOutcome {
-    let start = Instant::now();
+/// The N-map outcome of the pairs' reports (every pair a < b of `maps`, in order (0,1), (0,2), ..., (1,2), ...): a
+/// maximum spanning tree of the accepted pairs by confidence rooted at map 0, each map's transform into map 0's
+/// frame along the tree, and the maps joined to map 0 fused one by one (tree order) onto map 0 with `fusion`. Its
+/// `time_ms` counts from `start`.
+pub(crate) fn assemble(
+    maps: &[&OccupancyGrid],
+    pairs: Vec<PairReport>,
+    algorithm: &str,
+    fusion: FusionRule,
+    start: Instant,
+) -> MultiOutcome {
     let n = maps.len();
-    let index: Vec<(usize, usize)> = (0..n).flat_map(|a| (a + 1..n).map(move |b| (a, b))).collect();
-    let pairs: Vec<PairReport> = index
-        .par_iter()
-        .map(|&(a, b)| PairReport { a, b, report: merge(merger, &maps[a], &maps[b], params).report })
-        .collect();
     let edges: Vec<Edge> = pairs
         .iter()
         .enumerate()
         .filter(|(_, p)| p.report.accepted)
-        .filter_map(|(k, p)| Some((k, p.a, p.b, p.report.confidence, p.report.transform?.to_pose())))
+        .filter_map(|(pair, p)| {
+            let t_a_b = p.report.transform?.to_pose();
+            Some(Edge { pair, a: p.a, b: p.b, confidence: p.report.confidence, t_a_b })
+        })
         .collect();
     let forest = spanning_forest(n, &edges);
     let (components, tree, to_root) = orient(n, &forest);
@@ -223,10 +236,10 @@ pub fn merge_many(merger: &dyn Merger, maps: &[OccupancyGrid], params: &MergePar
     let merged = (joined.len() > 1).then(|| {
         tree.iter()
             .filter(|e| joined.contains(&e.child))
-            .fold(maps[0].clone(), |acc, e| fuse(&acc, &maps[e.child], &to_root[e.child], params.fusion))
+            .fold(maps[0].clone(), |acc, e| fuse(&acc, maps[e.child], &to_root[e.child], fusion))
     });
     let report = MultiReport {
-        algorithm: merger.name().to_string(),
+        algorithm: algorithm.to_string(),
         maps: n,
         pairs,
         tree,
@@ -234,7 +247,7 @@ pub fn merge_many(merger: &dyn Merger, maps: &[OccupancyGrid], params: &MergePar
         components,
         not_connected,
         disagreements,
-        time_ms: start.elapsed().as_secs_f64() * 1e3,
+        time_ms: ms(start),
     };
     MultiOutcome { report, merged }
 }
@@ -242,9 +255,12 @@ pub fn merge_many(merger: &dyn Merger, maps: &[OccupancyGrid], params: &MergePar
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::merger::{Alignment, Evidence, NoAlignment};
     use mrslam_core::pose;
-    use std::collections::BTreeMap;
+
+    /// An edge from its parts, in [`Edge`]'s order.
+    fn e(pair: usize, a: usize, b: usize, confidence: f64, t_a_b: Pose2) -> Edge {
+        Edge { pair, a, b, confidence, t_a_b }
+    }
 
     fn close(p: &Pose2, q: &Pose2) -> bool {
         let d = p.inverse() * q;
@@ -255,12 +271,12 @@ mod tests {
     fn the_forest_takes_the_most_confident_edges() {
         let t = Pose2::identity();
         // A triangle 0-1-2 and a weak 2-3: the weakest triangle edge (0-2) closes a cycle and is dropped.
-        let edges = vec![(0, 0, 1, 0.9, t), (1, 0, 2, 0.2, t), (3, 1, 2, 0.5, t), (5, 2, 3, 0.1, t)];
-        let kept: Vec<usize> = spanning_forest(4, &edges).iter().map(|e| e.0).collect();
+        let edges = vec![e(0, 0, 1, 0.9, t), e(1, 0, 2, 0.2, t), e(3, 1, 2, 0.5, t), e(5, 2, 3, 0.1, t)];
+        let kept: Vec<usize> = spanning_forest(4, &edges).iter().map(|e| e.pair).collect();
         assert_eq!(kept, vec![0, 3, 5]);
         // Equal confidence: the lower pair index wins.
-        let tie = vec![(4, 1, 2, 0.5, t), (0, 0, 1, 0.5, t), (2, 0, 2, 0.5, t)];
-        let kept: Vec<usize> = spanning_forest(3, &tie).iter().map(|e| e.0).collect();
+        let tie = vec![e(4, 1, 2, 0.5, t), e(0, 0, 1, 0.5, t), e(2, 0, 2, 0.5, t)];
+        let kept: Vec<usize> = spanning_forest(3, &tie).iter().map(|e| e.pair).collect();
         assert_eq!(kept, vec![0, 2]);
     }
 
@@ -270,7 +286,7 @@ mod tests {
         let t02 = t01 * t12;
         // A triangle whose weakest edge (0-2) agrees with the chain 0-1-2, then one that is a half turn off.
         for (t, off) in [(t02, false), (t02 * pose(0.3, -0.2, std::f64::consts::PI), true)] {
-            let edges = vec![(0, 0, 1, 0.9, t01), (1, 0, 2, 0.2, t), (2, 1, 2, 0.8, t12)];
+            let edges = vec![e(0, 0, 1, 0.9, t01), e(1, 0, 2, 0.2, t), e(2, 1, 2, 0.8, t12)];
             let forest = spanning_forest(3, &edges);
             let (components, _, to_root) = orient(3, &forest);
             let d = disagreements(&edges, &forest, &components, &to_root);
@@ -283,7 +299,7 @@ mod tests {
             }
         }
         // Pairs in different components are not compared (no chain joins them).
-        let edges = vec![(0, 0, 1, 0.9, t01), (1, 2, 3, 0.5, t12)];
+        let edges = vec![e(0, 0, 1, 0.9, t01), e(1, 2, 3, 0.5, t12)];
         let forest = spanning_forest(4, &edges);
         let (components, _, to_root) = orient(4, &forest);
         assert!(disagreements(&edges, &forest, &components, &to_root).is_empty());
@@ -295,92 +311,17 @@ mod tests {
         let t21 = pose(-0.5, 1.5, -1.1); // the pair (1, 2) gives T_1_2; store it that way
         let t12 = t21.inverse();
         let t13 = pose(3.0, -1.0, 2.0);
-        let forest = vec![(0, 0, 1, 0.9, t01), (3, 1, 2, 0.8, t12), (4, 1, 3, 0.7, t13)];
+        let forest = vec![e(0, 0, 1, 0.9, t01), e(3, 1, 2, 0.8, t12), e(4, 1, 3, 0.7, t13)];
         let (components, tree, to_root) = orient(4, &forest);
         assert_eq!(components, vec![vec![0, 1, 2, 3]]);
         assert!(close(&to_root[1], &t01));
         assert!(close(&to_root[2], &(t01 * t12)));
         assert!(close(&to_root[3], &(t01 * t13)));
         // A chain stored against the tree's direction: the pair (0, 1) rooted at 1 still gives T_0_1.
-        let (_, tree2, to_root2) = orient(3, &[(1, 1, 2, 0.5, t12), (0, 0, 2, 0.4, t21.inverse() * t01)]);
+        let (_, tree2, to_root2) = orient(3, &[e(1, 1, 2, 0.5, t12), e(0, 0, 2, 0.4, t21.inverse() * t01)]);
         assert_eq!((tree2[0].parent, tree2[0].child), (0, 2));
         assert!(close(&to_root2[2], &(t21.inverse() * t01)));
         assert!(close(&to_root2[1], &(t21.inverse() * t01 * t12.inverse())));
         assert_eq!(tree.iter().map(|e| (e.parent, e.child)).collect::<Vec<_>>(), vec![(0, 1), (1, 2), (1, 3)]);
-    }
-
-    /// Answers with known transforms between "maps" told apart by their width: width 10 + k is map k, placed
-    /// at `poses[k]` in a common world; pairs listed in `refuse` get no transform.
-    struct Known {
-        poses: Vec<Pose2>,
-        refuse: Vec<(usize, usize)>,
-    }
-
-    impl Merger for Known {
-        fn name(&self) -> &'static str {
-            "known"
-        }
-        fn align(&self, a: &OccupancyGrid, b: &OccupancyGrid) -> Result<Alignment, Box<NoAlignment>> {
-            let (i, j) = (a.width() - 10, b.width() - 10);
-            if self.refuse.contains(&(i, j)) || self.refuse.contains(&(j, i)) {
-                return Err(Box::new(NoAlignment {
-                    reason: "nothing in common".into(),
-                    matches: 0,
-                    timings_ms: BTreeMap::new(),
-                    evidence: Evidence::default(),
-                }));
-            }
-            Ok(Alignment {
-                transform: self.poses[i].inverse() * self.poses[j],
-                scale: 1.0,
-                matches: 40,
-                matched_features: 40,
-                inliers: 30 + i + j,
-                timings_ms: BTreeMap::new(),
-                evidence: Evidence::default(),
-                alternatives: Vec::new(),
-                alternatives_are_rivals: false,
-            })
-        }
-    }
-
-    #[test]
-    fn a_map_joined_to_nothing_is_reported_and_the_rest_placed() {
-        let poses = vec![pose(0.0, 0.0, 0.0), pose(2.0, 1.0, 0.5), pose(-1.0, 3.0, -2.0), pose(0.0, 0.0, 0.0)];
-        let refuse = vec![(0, 3), (1, 3), (2, 3)];
-        let maps: Vec<OccupancyGrid> =
-            (0..4).map(|k| OccupancyGrid::new(10 + k, 10, 0.1, pose(0.0, 0.0, 0.0)).unwrap()).collect();
-        let mut p = MergeParams { verify_enabled: false, ..MergeParams::default() };
-        p.refine.enabled = false;
-        let out = merge_many(&Known { poses: poses.clone(), refuse }, &maps, &p);
-        let r = &out.report;
-        assert_eq!(r.pairs.len(), 6);
-        assert_eq!(r.pairs.iter().map(|p| (p.a, p.b)).collect::<Vec<_>>()[..3], [(0, 1), (0, 2), (0, 3)]);
-        assert!(!r.pairs[2].report.accepted && r.pairs[2].report.reason.as_deref() == Some("nothing in common"));
-        assert_eq!(r.components, vec![vec![0, 1, 2], vec![3]]);
-        assert_eq!(r.not_connected, vec![3]);
-        assert!(!r.all_connected());
-        assert_eq!(r.tree.len(), 2);
-        for (i, (t, truth)) in r.transforms.iter().zip(&poses).take(3).enumerate() {
-            assert!(close(&t.unwrap().to_pose(), truth), "map {i}: {t:?}");
-        }
-        assert!(r.transforms[3].is_none());
-        assert!(out.merged.is_some());
-        // Two maps that join each other but not map 0 form their own component.
-        let out = merge_many(&Known { poses, refuse: vec![(0, 2), (0, 3), (1, 2), (1, 3)] }, &maps, &p);
-        assert_eq!(out.report.components, vec![vec![0, 1], vec![2, 3]]);
-        assert_eq!(out.report.not_connected, vec![2, 3]);
-        assert_eq!(out.report.tree.iter().map(|e| (e.parent, e.child)).collect::<Vec<_>>(), vec![(0, 1), (2, 3)]);
-    }
-
-    #[test]
-    fn no_maps_and_one_map_give_nothing_merged() {
-        let known = Known { poses: vec![Pose2::identity()], refuse: Vec::new() };
-        let out = merge_many(&known, &[], &MergeParams::default());
-        assert!(out.merged.is_none() && out.report.components.is_empty() && out.report.pairs.is_empty());
-        let one = [OccupancyGrid::new(10, 10, 0.1, pose(0.0, 0.0, 0.0)).unwrap()];
-        let out = merge_many(&known, &one, &MergeParams::default());
-        assert!(out.merged.is_none() && out.report.all_connected());
-        assert_eq!(out.report.transforms, vec![Some(Xyt::from_pose(&Pose2::identity()))]);
     }
 }

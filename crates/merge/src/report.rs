@@ -1,7 +1,10 @@
 //! The merge report: what `--report` writes, laid out in ARCHITECTURE.md, "Merge report".
 
-use mrslam_core::Xyt;
+use crate::alignment::Evidence;
+use crate::timing::ms;
+use mrslam_core::{OccupancyGrid, Xyt};
 use std::collections::BTreeMap;
+use std::time::Instant;
 
 /// Result of one merge, accepted or not. `transform` maps points of b's frame into a's frame.
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -38,4 +41,43 @@ pub struct MergeReport {
     pub time_ms: f64,
     /// Per-stage wall time, milliseconds.
     pub timings_ms: BTreeMap<String, f64>,
+}
+
+/// Everything a merge produced.
+#[derive(Debug, Clone)]
+pub struct MergeOutcome {
+    /// The report (also the JSON written by `--report`).
+    pub report: MergeReport,
+    /// The merged grid in a's frame, when accepted.
+    pub merged: Option<OccupancyGrid>,
+    /// The algorithm's evidence (present whether accepted or not).
+    pub evidence: Evidence,
+}
+
+/// The outcome of a merge refused before the gate: no transform, no merged map.
+pub(crate) fn refused(
+    algorithm: &str,
+    reason: String,
+    matches: usize,
+    timings_ms: BTreeMap<String, f64>,
+    start: Instant,
+) -> MergeOutcome {
+    let report = MergeReport {
+        accepted: false,
+        algorithm: algorithm.to_string(),
+        stage: None,
+        transform: None,
+        scale: None,
+        matches,
+        inliers: 0,
+        confidence: 0.0,
+        acceptance_index: None,
+        common_cells: 0,
+        wall_agreement: None,
+        ambiguity: None,
+        reason: Some(reason),
+        time_ms: ms(start),
+        timings_ms,
+    };
+    MergeOutcome { report, merged: None, evidence: Evidence::default() }
 }

@@ -1,10 +1,12 @@
 //! The paper's merger (Algorithm 3): maps → images → SIFT → ratio-test matches → robust transform.
 
+use crate::alignment::{Alignment, Evidence, Hypothesis, NoAlignment};
 use crate::estimate::{Estimate, Model, RansacParams, estimate_many};
 use crate::map_image::{MapEncoding, MapImage};
 use crate::matching::{MatchParams, match_features};
-use crate::merger::{Alignment, Evidence, Hypothesis, Merger, NoAlignment};
+use crate::merger::Merger;
 use crate::resample::to_resolution;
+use crate::timing::ms;
 use mrslam_core::OccupancyGrid;
 use mrslam_sift::{Features, GrayImage, Sift, SiftParams};
 use nalgebra::Point2;
@@ -78,10 +80,6 @@ impl SiftMerger {
     pub fn new(params: SiftMergerParams) -> Self {
         SiftMerger { params }
     }
-}
-
-fn ms(t: Instant) -> f64 {
-    t.elapsed().as_secs_f64() * 1e3
 }
 
 thread_local! {

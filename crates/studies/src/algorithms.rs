@@ -1,30 +1,6 @@
-//! The merge algorithms a study compares, built for one trial.
+//! The merge algorithms a study compares, read and checked.
 
-use mrslam_merge::{
-    Algorithm, Cascade, CorrelativeMerger, CorrelativeParams, MapEncoding, Merger, RmapMerger, RmapParams, SiftMerger,
-    SiftMergerParams,
-};
-
-/// `algorithm`'s merger with default parameters for a map-level trial seeded `seed`.
-///
-/// The correlative merger has no random draws. Only the SIFT merger's draws (also a cascade's) (its RANSAC) follow `seed`; the
-/// R-map merger's orientation draws keep their default seed ([`RmapParams::default`], 0) in every trial, as the published studies were computed. A
-/// simulated run ([`mrslam_testbed::runner::merger_for`]) seeds both with the scenario's seed.
-pub fn study_merger(algorithm: Algorithm, seed: u64) -> Box<dyn Merger> {
-    study_merger_encoded(algorithm, seed, MapEncoding::default())
-}
-
-/// [`study_merger`] with the SIFT merger's map-to-image encoding chosen (the other mergers have none).
-pub fn study_merger_encoded(algorithm: Algorithm, seed: u64, encoding: MapEncoding) -> Box<dyn Merger> {
-    let mut sift = SiftMergerParams { encoding, ..SiftMergerParams::default() };
-    sift.ransac.seed = seed;
-    match algorithm {
-        Algorithm::Sift => Box::new(SiftMerger::new(sift)),
-        Algorithm::Rmap => Box::new(RmapMerger::new(RmapParams::default())),
-        Algorithm::Correlative => Box::new(CorrelativeMerger::default()),
-        Algorithm::Cascade => Box::new(Cascade::new(sift, CorrelativeParams::default())),
-    }
-}
+use mrslam_merge::Algorithm;
 
 /// Checks a list of algorithms: not empty, none repeated.
 pub fn check_algorithms(algorithms: &[Algorithm]) -> Result<(), super::StudyError> {
@@ -66,5 +42,18 @@ mod tests {
         );
         assert_eq!(err(&["rmap", "rmap"]), "algorithm `rmap` given twice");
         assert_eq!(err(&[]), "no algorithms given");
+    }
+
+    #[test]
+    fn a_trial_and_a_simulated_run_build_the_same_merger_for_the_same_seed() {
+        use mrslam_merge::MergerConfig;
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenarios/paper_two_rooms.toml");
+        let mut s = mrslam_testbed::scenario::Scenario::from_file(&path).unwrap();
+        // The scenario's merge settings set to the defaults a study uses.
+        (s.merge.candidates, s.merge.hypotheses, s.merge.wall_dilation) = (1, 1, 0);
+        s.seed = 23;
+        for a in Algorithm::ALL {
+            assert_eq!(mrslam_testbed::runner::merger_for(a, &s), MergerConfig::new(a, 23), "{a}");
+        }
     }
 }

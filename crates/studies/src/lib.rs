@@ -101,7 +101,7 @@ pub trait Progress: Sync {
 /// No resume, nothing reported.
 impl Progress for () {}
 
-pub use algorithms::{check_algorithms, parse_algorithms, study_merger, study_merger_encoded};
+pub use algorithms::{check_algorithms, parse_algorithms};
 pub use range::parse_range;
 pub use shard::Shard;
 pub use sweep::{Sweep, run_sweep};

@@ -11,13 +11,12 @@
 //! it is reported beside each merge as the floor.
 
 use super::StudyError;
-use super::algorithms::study_merger_encoded;
 use super::results::TrialRow;
 use mrslam_core::relations::{Relation, StampedPose, pose_at};
 use mrslam_core::{CellState, OccupancyGrid, Pose2};
 use mrslam_core::{Xyt, pose, pose::normalize_angle};
 use mrslam_log::{ScanRecord, span};
-use mrslam_merge::{Algorithm, MapEncoding, MergeParams, merge};
+use mrslam_merge::{Algorithm, Encoding, MergeParams, MergerConfig, merge};
 use mrslam_slam::{LogRunError, Rbpf, SlamParams, map_log};
 use mrslam_testbed::eval::transform_error;
 use std::collections::BTreeMap;
@@ -278,7 +277,7 @@ pub struct ScoreParams {
     /// Seed of the mergers' random draws.
     pub seed: u64,
     /// The SIFT merger's map-to-image encoding.
-    pub encoding: MapEncoding,
+    pub encoding: Encoding,
     /// The verification gate's wall tolerance, cells ([`mrslam_merge::VerifyParams::wall_tolerance_cells`]).
     pub wall_tolerance_cells: usize,
 }
@@ -289,7 +288,7 @@ impl Default for ScoreParams {
             max_error_m: MAX_ERROR_M,
             max_error_deg: MAX_ERROR_DEG,
             seed: 0,
-            encoding: MapEncoding::default(),
+            encoding: Encoding::default(),
             wall_tolerance_cells: mrslam_merge::VerifyParams::default().wall_tolerance_cells,
         }
     }
@@ -430,7 +429,7 @@ pub fn merge_pair(
         .ok_or_else(|| StudyError::Invalid(format!("parts {i} and {j}: no relation connects them")))?;
     let truth_error = median_error(&truth, cross).unwrap_or((f64::NAN, f64::NAN));
     let (overlap, overlap_smaller) = overlap(a, b, &truth);
-    let merger = study_merger_encoded(algorithm, p.seed, p.encoding);
+    let merger = MergerConfig { encoding: p.encoding, ..MergerConfig::new(algorithm, p.seed) }.build();
     let mut mp = MergeParams::default();
     mp.verify.wall_tolerance_cells = p.wall_tolerance_cells;
     let out = merge(merger.as_ref(), a, b, &mp);

@@ -1,7 +1,7 @@
 //! Map-level studies: cut ground-truth maps into pairs of chosen overlap, merge each pair with every
 //! algorithm through the verification gate, score against the pair's true transform.
 
-use super::algorithms::{check_algorithms, study_merger_encoded};
+use super::algorithms::check_algorithms;
 use super::results::{TrialRow, sort_rows};
 use super::shard::Shard;
 use super::trial::{TrialSpec, mix, trials};
@@ -9,7 +9,7 @@ use super::{Progress, StudyError};
 use mrslam_core::{CellState, OccupancyGrid};
 use mrslam_merge::floorplan::{FloorplanParams, generate};
 use mrslam_merge::pairs::{PairSpec, cut_pair};
-use mrslam_merge::{Algorithm, MapEncoding, MergeParams, merge};
+use mrslam_merge::{Algorithm, Encoding, MergeParams, MergerConfig, merge};
 use mrslam_testbed::eval::transform_error;
 use rayon::prelude::*;
 
@@ -51,7 +51,7 @@ pub struct OverlapStudy {
     /// How the pair's maps store their walls.
     pub style: MapStyle,
     /// The SIFT merger's map-to-image encoding.
-    pub encoding: MapEncoding,
+    pub encoding: Encoding,
 }
 
 /// How a pair's maps store their walls.
@@ -170,7 +170,8 @@ fn run_trial(study: &OverlapStudy, map: &OccupancyGrid, t: &TrialSpec) -> Vec<Tr
         .algorithms
         .iter()
         .map(|&algorithm| {
-            let merger = study_merger_encoded(algorithm, t.seed, study.encoding);
+            // Every random draw of the merger follows the trial's seed.
+            let merger = MergerConfig { encoding: study.encoding, ..MergerConfig::new(algorithm, t.seed) }.build();
             let out = merge(merger.as_ref(), &pair.a, &pair.b, &MergeParams::default());
             let err = out.report.transform.map(|x| transform_error(&x.to_pose(), &pair.t_a_b));
             let accepted = out.report.accepted;
@@ -234,7 +235,7 @@ mod tests {
             max_shift_m: 3.0,
             shard: Shard::ALL,
             style: MapStyle::Walls,
-            encoding: MapEncoding::default(),
+            encoding: Encoding::default(),
         }
     }
 

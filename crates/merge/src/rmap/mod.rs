@@ -56,8 +56,10 @@ pub use mers::{CoverRule, FreeMatrix, Mer, Rmap};
 pub use orient::OrientParams;
 pub use triangle::{TriangleMatch, TriangleParams};
 
-use crate::merger::{Alignment, Evidence, Merger, NoAlignment};
+use crate::alignment::{Alignment, Evidence, NoAlignment};
+use crate::merger::Merger;
 use crate::resample::{resample, to_resolution};
+use crate::timing::ms;
 use mrslam_core::{OccupancyGrid, pose};
 use nalgebra::{Point2, Rotation2};
 use std::collections::BTreeMap;
@@ -129,10 +131,6 @@ pub struct RmapResult {
     pub triangle_pairs: usize,
     /// MER count of each map's R-map (before rotation).
     pub mer_counts: (usize, usize),
-}
-
-fn ms(t: Instant) -> f64 {
-    t.elapsed().as_secs_f64() * 1e3
 }
 
 /// A map brought into its axis-aligned frame, with its R-map.

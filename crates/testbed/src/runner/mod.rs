@@ -19,34 +19,21 @@ pub use record::merge_view;
 
 use crate::report::RunReport;
 use crate::scenario::Scenario;
-use mrslam_merge::{
-    Algorithm, Cascade, CorrelativeMerger, CorrelativeParams, MatchParams, Merger, RmapMerger, RmapParams, SiftMerger,
-    SiftMergerParams,
-};
+use mrslam_merge::{Algorithm, Merger, MergerConfig};
 use mrslam_sim::{Sim, SimConfig};
 use std::time::Instant;
 
-/// Builds `algorithm`'s merger with the scenario's merge settings, its random draws seeded by the scenario's seed.
-pub fn merger_for(algorithm: Algorithm, scenario: &Scenario) -> Box<dyn Merger> {
+/// `algorithm`'s merger settings from the scenario's merge settings, its random draws seeded by the scenario's seed.
+pub fn merger_for(algorithm: Algorithm, scenario: &Scenario) -> MergerConfig {
     let m = &scenario.merge;
-    let mut sift = SiftMergerParams {
+    MergerConfig {
         model: m.model,
         encoding: m.encoding,
-        matching: MatchParams { ratio: m.ratio, candidates: m.candidates, ..MatchParams::default() },
+        ratio: m.ratio,
+        candidates: m.candidates,
         hypotheses: m.hypotheses,
         wall_dilation: m.wall_dilation,
-        ..SiftMergerParams::default()
-    };
-    sift.ransac.seed = scenario.seed;
-    match algorithm {
-        Algorithm::Sift => Box::new(SiftMerger::new(sift)),
-        Algorithm::Rmap => {
-            let mut p = RmapParams::default();
-            p.orient.seed = scenario.seed;
-            Box::new(RmapMerger::new(p))
-        }
-        Algorithm::Correlative => Box::new(CorrelativeMerger::default()),
-        Algorithm::Cascade => Box::new(Cascade::new(sift, CorrelativeParams::default())),
+        ..MergerConfig::new(algorithm, scenario.seed)
     }
 }
 
@@ -75,7 +62,7 @@ pub fn run(scenario: &Scenario, mut opts: RunOptions) -> Result<RunOutput, RunEr
         a.slam.finish();
     }
     let evaluated = evaluate::evaluate_robots(&agents, &truth, &mut opts)?;
-    let mergers: Vec<(Algorithm, Box<dyn Merger>)> = algorithms.iter().map(|&a| (a, merger_for(a, scenario))).collect();
+    let mergers: Vec<(Algorithm, Box<dyn Merger>)> = algorithms.iter().map(|&a| (a, merger_for(a, scenario).build())).collect();
     let pair = (host.as_str(), other.as_str());
     let (results, merges) = merge::merge_maps(scenario, &mergers, &evaluated, pair, &truth, &mut opts);
     let observed_overlap = merge::observed_overlap(&agents, pair);
@@ -123,10 +110,14 @@ mod tests {
     }
 
     #[test]
-    fn every_algorithm_gets_its_own_merger() {
-        let s = two_rooms();
+    fn a_scenarios_merger_follows_its_settings_and_seed() {
+        let mut s = two_rooms();
+        s.seed = 17;
+        s.merge.hypotheses = 3;
         for a in Algorithm::ALL {
-            assert_eq!(merger_for(a, &s).name(), a.name());
+            let c = merger_for(a, &s);
+            assert_eq!((c.algorithm, c.seed, c.hypotheses), (a, 17, 3));
+            assert_eq!(c.build().name(), a.name());
         }
     }
 }

@@ -3,7 +3,7 @@
 use super::error::{Ctx, ScenarioError};
 use super::file::MergeFile;
 use super::robot::RobotSetup;
-use mrslam_merge::{Algorithm, MapEncoding, Model};
+use mrslam_merge::{Algorithm, Encoding, Model};
 
 /// When the maps are merged.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -28,7 +28,7 @@ pub struct MergeSetup {
     /// Lowe's ratio.
     pub ratio: f32,
     /// Map-to-image encoding.
-    pub encoding: MapEncoding,
+    pub encoding: Encoding,
     /// Descriptor candidates per feature (1: nearest neighbour with the ratio test, as the paper).
     pub candidates: usize,
     /// Transforms handed to verification (1: the paper's single answer).
@@ -78,12 +78,9 @@ pub(super) fn resolve_merge(
     if !(ratio > 0.0 && ratio <= 1.0) {
         return Err(cx.err("merge.ratio", format!("must lie in (0, 1], got {ratio}")));
     }
-    let encoding = match m.encoding.as_deref() {
-        None | Some("walls") => MapEncoding::WALLS,
-        Some("paper") => MapEncoding::PAPER,
-        Some(e) => {
-            return Err(cx.err("merge.encoding", format!("unknown encoding `{e}` (expected walls or paper)")));
-        }
+    let encoding = match &m.encoding {
+        None => Encoding::default(),
+        Some(s) => s.parse().map_err(|e: String| cx.err("merge.encoding", e))?,
     };
     let host = m.host.clone().unwrap_or_else(|| robots[0].name.clone());
     if !robots.iter().any(|r| r.name == host) {

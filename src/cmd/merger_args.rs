@@ -1,0 +1,141 @@
+//! The merger's flags (`mrslam merge`, two maps or more): the algorithm, its settings, the pipeline around it.
+
+use super::args::one_of;
+use clap::Args;
+use mrslam_merge::{Algorithm, BoundaryWalls, Encoding, FusionRule, MergeParams, MergerConfig, Model};
+
+/// The merger and the pipeline around it, as flags.
+#[derive(Args)]
+pub struct MergerArgs {
+    /// Merge algorithm: `sift` (the paper's, Alg. 3), `rmap` (Park's R-map baseline, Alg. 1), `correlative`
+    /// (global correlative search by branch and bound) or `cascade` (`sift`, `sift` with every map's boundary as
+    /// walls, then `correlative`: the first answer the gate accepts; the default, chosen by measurement on
+    /// generated plans, cuts of a real map and two robots' SLAM maps: benchmarks/runs/2026-12-02-merge-cascade.md).
+    #[arg(long, default_value = "cascade", value_parser = one_of::<Algorithm>(Algorithm::ALL.map(Algorithm::name)))]
+    pub algorithm: Algorithm,
+    /// Transform model: rigid, similarity or homography (the paper's; its rigid part is used).
+    #[arg(long, default_value = "rigid", value_parser = one_of::<Model>(Model::ALL.map(Model::name)))]
+    pub model: Model,
+    /// Lowe's ratio for descriptor matching, in (0, 1].
+    #[arg(long, default_value_t = 0.75, value_parser = ratio)]
+    pub ratio: f32,
+    /// Keep only mutual nearest-neighbour matches.
+    #[arg(long)]
+    pub mutual: bool,
+    /// Candidates per feature: 1 = nearest neighbour with the ratio test (the paper); k > 1 = the k nearest.
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=16))]
+    pub candidates: u32,
+    /// Transforms handed to verification, strongest first (sequential RANSAC); 1 = the paper's single answer.
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=16))]
+    pub hypotheses: u32,
+    /// Grow occupied cells by this many cells before SIFT (0 = the map as it is).
+    #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u32).range(0..=4))]
+    pub wall_dilation: u32,
+    /// The verification gate's wall tolerance: a wall of map b meets a wall of map a within this many cells
+    /// (1: the 3x3 neighbourhood; 2 lets the walls of two robots' SLAM runs meet).
+    #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u32).range(0..=4))]
+    pub wall_tolerance: u32,
+    /// Which maps get walls where their free space meets unknown: `unmarked` (maps with almost no occupied
+    /// cells: map_server's light-grey walls, glass), `always` (every map, its own walls kept) or `off` (the maps
+    /// as they are: the paper's merger has no such step; a cascade then skips its `sift+boundary` stage).
+    #[arg(
+        long,
+        default_value = "unmarked",
+        value_parser = one_of::<BoundaryWalls>(BoundaryWalls::ALL.map(BoundaryWalls::name))
+    )]
+    pub boundary_walls: BoundaryWalls,
+    /// The correlative merger's significance test: its best pose must score this share above every pose clearly
+    /// apart from it (Lowe's ratio test), else the merge is refused as ambiguous, naming the rival; 0 turns the
+    /// test off [default: `CorrelativeParams::default().min_margin`, 0.15].
+    #[arg(long, value_parser = margin)]
+    pub min_margin: Option<f64>,
+    /// The correlative merger's answer is not checked by the same search the other way round (the other map's
+    /// walls on this one's); the check refuses answers that are ambiguous that way.
+    #[arg(long)]
+    pub one_way: bool,
+    /// Map-to-image encoding: `walls` (free and unknown alike) or `paper` (unknown grey).
+    #[arg(long, default_value = "walls", value_parser = one_of::<Encoding>(Encoding::ALL.map(Encoding::name)))]
+    pub encoding: Encoding,
+    /// How aligned cells combine: log-odds-sum or occupied-free-unknown.
+    #[arg(long, default_value = "log-odds-sum", value_parser = one_of::<FusionRule>(FusionRule::ALL.map(FusionRule::name)))]
+    pub fusion: FusionRule,
+    /// Skip the verification gate and accept whatever the algorithm answers.
+    #[arg(long)]
+    pub no_verify: bool,
+    /// Seed of the merger's random draws (the robust estimator's, the R-map's).
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+}
+
+impl MergerArgs {
+    /// The merger the flags describe.
+    pub fn config(&self) -> MergerConfig {
+        let defaults = MergerConfig::default();
+        MergerConfig {
+            algorithm: self.algorithm,
+            model: self.model,
+            encoding: self.encoding,
+            ratio: self.ratio,
+            candidates: self.candidates as usize,
+            mutual: self.mutual,
+            hypotheses: self.hypotheses as usize,
+            wall_dilation: self.wall_dilation as usize,
+            // One merge has the machine to itself: the two maps' features on two threads (the studies, which run
+            // merges side by side, keep one thread per merge).
+            parallel: true,
+            min_margin: self.min_margin.unwrap_or(defaults.min_margin),
+            cross_check: !self.one_way,
+            seed: self.seed,
+        }
+    }
+
+    /// The pipeline around the merger: the gate, the fusion, the boundary walls.
+    pub fn params(&self) -> MergeParams {
+        let mut mp = MergeParams {
+            verify_enabled: !self.no_verify,
+            fusion: self.fusion,
+            boundary_walls: self.boundary_walls,
+            ..MergeParams::default()
+        };
+        mp.verify.wall_tolerance_cells = self.wall_tolerance as usize;
+        mp
+    }
+}
+
+/// Reads `--ratio`: a number in (0, 1] (a ratio above 1 accepts every match).
+fn ratio(s: &str) -> Result<f32, String> {
+    match s.parse::<f32>() {
+        Ok(r) if r > 0.0 && r <= 1.0 => Ok(r),
+        Ok(r) => Err(format!("{r} is outside (0, 1]")),
+        Err(e) => Err(e.to_string()),
+    }
+}
+
+/// Reads `--min-margin`: a number in [0, 1).
+fn margin(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(m) if (0.0..1.0).contains(&m) => Ok(m),
+        Ok(m) => Err(format!("{m} is outside [0, 1)")),
+        Err(e) => Err(e.to_string()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+
+    #[derive(Parser)]
+    struct Cli {
+        #[command(flatten)]
+        merger: MergerArgs,
+    }
+
+    #[test]
+    fn the_default_flags_are_the_default_merger_on_two_threads() {
+        let cli = Cli::try_parse_from(["x", "--seed", "4"]).unwrap();
+        let expected = MergerConfig { parallel: true, ..MergerConfig::new(Algorithm::Cascade, 4) };
+        assert_eq!(cli.merger.config(), expected);
+        assert_eq!(cli.merger.params(), MergeParams::default());
+    }
+}

@@ -1,0 +1,140 @@
+//! `mrslam study`: many seeded merge trials across overlaps — map level (`overlap`), simulation level
+//! (`scenario`), real data (`logs`: a real log split in time into robots), and joining the shards of a study
+//! split across machines (`collect`). One module per subcommand; the progress, resume and output helpers they
+//! share here.
+
+mod collect;
+mod logs;
+mod overlap;
+mod scenario;
+
+use anyhow::{Context, Result};
+use clap::Subcommand;
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use mrslam_studies::journal::{Journal, StudyParams};
+use mrslam_studies::results::{TrialRow, sort_rows};
+use mrslam_studies::summary::table;
+use mrslam_studies::{self as study, Progress, Shard, StudyError};
+use std::collections::BTreeSet;
+use std::io::IsTerminal;
+use std::path::Path;
+use std::process::ExitCode;
+use std::time::Instant;
+
+/// `mrslam study` subcommands.
+#[derive(Subcommand)]
+pub enum StudyCommand {
+    /// Map-level study: cut ground-truth maps into pairs of chosen overlap, merge with each algorithm.
+    Overlap(overlap::OverlapArgs),
+    /// Simulation-level study: run a scenario sweep (simulation, SLAM, merge) and score each merge.
+    Scenario(scenario::ScenarioArgs),
+    /// Join the results.csv of a study's shards, then redraw summary.csv and plot.png.
+    Collect(collect::CollectArgs),
+    /// Real-data study: split a CARMEN log in time into N robots, map each with the SLAM, merge every pair
+    /// the relations connect with each algorithm, score against the relations.
+    Logs(logs::LogsArgs),
+}
+
+/// Runs `mrslam study`.
+pub fn run(cmd: StudyCommand) -> Result<ExitCode> {
+    match cmd {
+        StudyCommand::Overlap(a) => overlap::run(a),
+        StudyCommand::Scenario(a) => scenario::run(a),
+        StudyCommand::Collect(a) => collect::run(a),
+        StudyCommand::Logs(a) => logs::run(a),
+    }
+}
+
+pub(super) fn shard_of(arg: Option<&str>) -> Result<Shard> {
+    Ok(match arg {
+        Some(s) => Shard::parse(s).context("--shard")?,
+        None => Shard::from_slurm(|k| std::env::var(k).ok())?.unwrap_or(Shard::ALL),
+    })
+}
+
+pub(super) fn progress_bar(len: usize, quiet: bool, what: &str) -> ProgressBar {
+    let bar = ProgressBar::new(len as u64);
+    if quiet || !std::io::stderr().is_terminal() {
+        bar.set_draw_target(ProgressDrawTarget::hidden());
+    }
+    bar.set_style(
+        ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} trials, {per_sec}, {elapsed} elapsed, ETA {eta}")
+            .expect("valid template")
+            .progress_chars("=> "),
+    );
+    bar.set_message(what.to_string());
+    bar
+}
+
+pub(super) fn create_out(dir: &Path) -> Result<()> {
+    std::fs::create_dir_all(dir).with_context(|| format!("{}: cannot create output folder", dir.display()))
+}
+
+/// A running study's progress: the trials done before a resume are skipped; each finished trial's rows are
+/// appended to results.csv at once, so an interruption loses no finished trial.
+pub(super) struct Recorder {
+    journal: Journal,
+    done: BTreeSet<usize>,
+    bar: ProgressBar,
+}
+
+impl Progress for Recorder {
+    fn skip(&self, trial: usize) -> bool {
+        self.done.contains(&trial)
+    }
+
+    fn finished(&self, rows: &[TrialRow]) -> Result<(), StudyError> {
+        self.journal.append(rows)?;
+        self.bar.inc(1);
+        Ok(())
+    }
+}
+
+/// Opens the study folder (fresh or resumed) and says what a resume found.
+pub(super) fn open_study(
+    out: &Path,
+    params: &StudyParams,
+    rows_per_trial: usize,
+    resume: bool,
+) -> Result<(Journal, Vec<TrialRow>)> {
+    create_out(out)?;
+    let (journal, earlier) = Journal::open(out, params, rows_per_trial, resume)?;
+    if resume {
+        let trials: BTreeSet<usize> = earlier.iter().map(|r| r.trial).collect();
+        println!("resuming {}: {} trials already done", out.display(), trials.len());
+    }
+    Ok((journal, earlier))
+}
+
+/// Runs the trials not yet done, then joins the rows with those of before the resume.
+pub(super) fn run_study(
+    earlier: Vec<TrialRow>,
+    journal: Journal,
+    selected: &[usize],
+    algorithms: &[String],
+    quiet: bool,
+    what: &str,
+    run: impl FnOnce(&Recorder) -> Result<Vec<TrialRow>, StudyError>,
+) -> Result<(Vec<TrialRow>, usize, f64)> {
+    let done: BTreeSet<usize> = earlier.iter().map(|r| r.trial).collect();
+    let n = selected.iter().filter(|t| !done.contains(t)).count();
+    let recorder = Recorder { journal, done, bar: progress_bar(n, quiet, what) };
+    let start = Instant::now();
+    let new = run(&recorder)?;
+    let seconds = start.elapsed().as_secs_f64();
+    recorder.bar.finish_and_clear();
+    let mut rows = earlier;
+    rows.extend(new);
+    sort_rows(&mut rows, algorithms);
+    Ok((rows, n, seconds))
+}
+
+pub(super) fn finish(rows: &[TrialRow], out: &Path, trials: usize, seconds: Option<f64>) -> Result<ExitCode> {
+    let summary = study::write_outputs(rows, out)?;
+    print!("{}", table(&summary));
+    if let Some(s) = seconds {
+        println!("{trials} trials ({} rows) in {s:.1} s: {:.2} trials/s", rows.len(), trials as f64 / s.max(1e-9));
+    }
+    println!("outputs:  {} (study.json, results.csv, summary.csv, plot.png)", out.display());
+    Ok(ExitCode::SUCCESS)
+}

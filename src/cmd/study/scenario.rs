@@ -1,0 +1,75 @@
+//! `mrslam study scenario`: a scenario sweep (simulation, SLAM, merge), each merge scored.
+
+use super::{finish, open_study, run_study, shard_of};
+use anyhow::{Context, Result};
+use clap::Args;
+use mrslam_studies::journal::{StudyParams, fingerprint};
+use mrslam_studies::{Sweep, run_sweep};
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+/// Arguments of `mrslam study scenario`.
+#[derive(Args)]
+pub struct ScenarioArgs {
+    /// Sweep file (TOML), e.g. scenarios/corridor_sweep.toml.
+    pub sweep: PathBuf,
+    /// Output folder: results.csv, summary.csv, plot.png.
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Run only shard K of N (trial index mod N = K); default from SLURM_ARRAY_TASK_ID/SLURM_ARRAY_TASK_COUNT.
+    #[arg(long)]
+    pub shard: Option<String>,
+    /// No progress bar.
+    #[arg(long)]
+    pub quiet: bool,
+    /// Read and check the sweep, list its trials, run nothing.
+    #[arg(long)]
+    pub dry_run: bool,
+    /// Continue the interrupted study in --out: run only the trials its results.csv lacks.
+    #[arg(long)]
+    pub resume: bool,
+}
+
+/// Runs `mrslam study scenario`.
+pub(super) fn run(a: ScenarioArgs) -> Result<ExitCode> {
+    let shard = shard_of(a.shard.as_deref())?;
+    let sweep = Sweep::from_file(&a.sweep)?;
+    if a.dry_run {
+        println!(
+            "{}: scenario {}, {} trials ({} variants x {} seeds), algorithms {}",
+            a.sweep.display(),
+            sweep.scenario.name,
+            sweep.trials(),
+            sweep.variants(),
+            sweep.seeds.len(),
+            sweep.algorithms.iter().map(|a| a.name()).collect::<Vec<_>>().join(",")
+        );
+        if let Some(d) = &sweep.scenario.description {
+            println!("  {d}");
+        }
+        for t in (0..sweep.trials()).filter(|t| shard.selects(*t)) {
+            println!("trial {t}: {}", sweep.describe(t));
+        }
+        return Ok(ExitCode::SUCCESS);
+    }
+    let mut params = StudyParams::default();
+    params.set("kind", "scenario");
+    for (name, path) in
+        [("sweep", &sweep.path), ("scenario", &sweep.scenario.path), ("world", &sweep.scenario.world_path)]
+    {
+        let bytes = std::fs::read(path).with_context(|| format!("{}", path.display()))?;
+        params.set(
+            name,
+            format!("{} {}", path.file_name().map(|f| f.to_string_lossy()).unwrap_or_default(), fingerprint(&bytes)),
+        );
+    }
+    let algorithms: Vec<String> = sweep.algorithms.iter().map(|x| x.name().to_string()).collect();
+    params.set("algorithms", algorithms.join(","));
+    params.set("seeds", sweep.seeds.iter().map(u64::to_string).collect::<Vec<_>>().join(","));
+    let (journal, earlier) = open_study(&a.out, &params, algorithms.len(), a.resume)?;
+    let selected: Vec<usize> = (0..sweep.trials()).filter(|t| shard.selects(*t)).collect();
+    let (rows, n, seconds) = run_study(earlier, journal, &selected, &algorithms, a.quiet, &sweep.scenario.name, |p| {
+        run_sweep(&sweep, shard, p)
+    })?;
+    finish(&rows, &a.out, n, Some(seconds))
+}
