@@ -55,8 +55,8 @@ impl Default for MergerConfig {
             hypotheses: sift.hypotheses,
             wall_dilation: sift.wall_dilation,
             parallel: sift.parallel,
-            min_margin: correlative.min_margin,
-            cross_check: correlative.cross_check,
+            min_margin: correlative.answer.min_margin,
+            cross_check: correlative.answer.cross_check,
             seed: 0,
         }
     }
@@ -91,8 +91,8 @@ impl MergerConfig {
     /// The correlative search's parameters (also a cascade's last stage's).
     pub fn correlative(&self) -> CorrelativeParams {
         let mut p = CorrelativeParams::default();
-        p.min_margin = self.min_margin;
-        p.cross_check = self.cross_check;
+        p.answer.min_margin = self.min_margin;
+        p.answer.cross_check = self.cross_check;
         p
     }
 

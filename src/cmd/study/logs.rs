@@ -226,12 +226,11 @@ pub(super) fn run(a: LogsArgs) -> Result<ExitCode> {
             map_io::write_ros_map_with_preview(&part.map, &map_path)
                 .with_context(|| format!("{}", map_path.display()))?;
             let header = format!(
-                "mrslam study logs: part {k} of {} of {} (lines {} to {}), one pose per scan, `stamp x y theta`, \
+                "mrslam study logs: part {k} of {} of {} ({}), one pose per scan, `stamp x y theta`, \
                  in the part's map frame ({} scans processed by the filter, the others placed by odometry)",
                 a.parts,
                 a.log.display(),
-                scans[0].line,
-                scans[scans.len() - 1].line,
+                readings(&scans[0].source, &scans[scans.len() - 1].source),
                 part.processed
             );
             write_file_atomic(&traj_path, relations::format_trajectory(&header, &part.trajectory).as_bytes())?;
@@ -312,4 +311,12 @@ pub(super) fn run(a: LogsArgs) -> Result<ExitCode> {
         a.out.display()
     );
     Ok(ExitCode::SUCCESS)
+}
+
+/// The part's readings as its trajectory header names them: "lines 5 to 900" in a text log.
+fn readings(first: &mrslam_log::Source, last: &mrslam_log::Source) -> String {
+    match (first, last) {
+        (mrslam_log::Source::Line(a), mrslam_log::Source::Line(b)) => format!("lines {a} to {b}"),
+        _ => mrslam_log::span(first, last),
+    }
 }

@@ -62,7 +62,8 @@ pub fn run(scenario: &Scenario, mut opts: RunOptions) -> Result<RunOutput, RunEr
         a.slam.finish();
     }
     let evaluated = evaluate::evaluate_robots(&agents, &truth, &mut opts)?;
-    let mergers: Vec<(Algorithm, Box<dyn Merger>)> = algorithms.iter().map(|&a| (a, merger_for(a, scenario).build())).collect();
+    let mergers: Vec<(Algorithm, Box<dyn Merger>)> =
+        algorithms.iter().map(|&a| (a, merger_for(a, scenario).build())).collect();
     let pair = (host.as_str(), other.as_str());
     let (results, merges) = merge::merge_maps(scenario, &mergers, &evaluated, pair, &truth, &mut opts);
     let observed_overlap = merge::observed_overlap(&agents, pair);
