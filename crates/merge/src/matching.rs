@@ -4,8 +4,8 @@ use mrslam_sift::{DESCRIPTOR_LEN, Features};
 use rayon::prelude::*;
 
 /// A correspondence between feature `a` of the first set and feature `b` of the second.
-#[derive(Debug, Clone, Copy, PartialEq)]
 /// Public (through the crate's `dev` module) only for the tests, benches and development probes.
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Match {
     /// Index in the first feature set.
     pub a: usize,

@@ -33,7 +33,7 @@ pub struct VerifyParams {
     #[serde(default = "default_max_rival_ratio")]
     pub max_rival_ratio: f64,
     /// A wall of b meets a wall of a ([`Agreement::walls_matched`]) when an occupied cell of a lies within this
-    /// many cells of it (in x and in y; 1: the 3x3 neighbourhood, the gate before 2026-12-02). Maps that two
+    /// many cells of it (in x and in y; 1: the 3x3 neighbourhood). Maps that two
     /// robots made have walls a cell or two apart where the two SLAM runs disagree (ACES: 47-59 % of the walls
     /// within one cell at the right transform, 60 % needed); on generated and willow pairs 2 cells changed no
     /// decision (BENCHMARKS.md, Merge). The rival check compares walls within one cell regardless.

@@ -100,8 +100,8 @@ const LINE_OUTLIER: f64 = 0.3;
 const LINE_WEIGHT_CAP: u32 = 10;
 
 /// What a beam end point finds in the field.
-#[derive(Debug, Clone, Copy, PartialEq)]
 /// Public (through the crate's `dev` module) only for the tests, benches and development probes.
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Lookup {
     /// A surface within reach, at squared distance d² (m²).
     Hit(f64),

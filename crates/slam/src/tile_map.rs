@@ -66,8 +66,8 @@ impl Tile {
 }
 
 /// A grid of hit statistics made of copy-on-write tiles.
-#[derive(Clone)]
 /// Public (through the crate's `dev` module) only for the tests, benches and development probes.
+#[derive(Clone)]
 pub struct TileMap {
     delta: f64,
     inv_delta: f64,

@@ -26,8 +26,8 @@
 use mrslam_core::{CellState, OccupancyGrid};
 
 /// A maximal empty rectangle: columns `x..x + w`, rows `y..y + h` of the free matrix.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 /// Public (through the crate's `dev` module) only for the tests, benches and development probes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub struct Mer {
     /// Left column (the paper's upper-left corner, with row 0 drawn first).
     pub x: usize,
@@ -63,8 +63,8 @@ impl Mer {
 }
 
 /// The binary matrix of a G-map: which cells are free (1 in the paper), and what the others are.
-#[derive(Debug, Clone, PartialEq)]
 /// Public (through the crate's `dev` module) only for the tests, benches and development probes.
+#[derive(Debug, Clone, PartialEq)]
 pub struct FreeMatrix {
     /// Columns.
     pub width: usize,

@@ -63,8 +63,8 @@ impl Beam {
 }
 
 /// A scan prepared for matching and mapping.
-#[derive(Debug, Clone, Default)]
 /// Public (through the crate's `dev` module) only for the tests, benches and development probes.
+#[derive(Debug, Clone, Default)]
 pub struct PreparedScan {
     /// Beams the matcher uses: valid, within the usable range, every (lskip+1)-th.
     pub matched: Vec<Beam>,
@@ -102,8 +102,8 @@ impl PreparedScan {
 }
 
 /// A scan matcher: its parameters and the laser mount it matches from.
-#[derive(Debug, Clone, Copy, PartialEq)]
 /// Public (through the crate's `dev` module) only for the tests, benches and development probes.
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ScanMatcher {
     /// Laser mount pose on the robot.
     pub laser: Xyt,
@@ -178,8 +178,8 @@ impl PosePrior {
 }
 
 /// Per-thread working memory of the matcher (the likelihood field), reused between particles.
-#[derive(Debug, Clone, Default)]
 /// Public (through the crate's `dev` module) only for the tests, benches and development probes.
+#[derive(Debug, Clone, Default)]
 pub struct Scratch {
     /// The field of the particle being matched.
     pub field: Field,

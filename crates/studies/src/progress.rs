@@ -1,0 +1,20 @@
+//! What a study does as it goes: resume and hand over finished rows.
+
+use crate::StudyError;
+use crate::results::TrialRow;
+
+/// What a study does as it goes: it asks whether to run each selected trial (a resumed study skips those it
+/// has), and hands over each finished trial's rows at once (the CLI appends them to `results.csv`).
+pub trait Progress: Sync {
+    /// Whether trial `trial` is already done and is to be skipped.
+    fn skip(&self, _trial: usize) -> bool {
+        false
+    }
+    /// Called with the rows of each finished trial, from the worker thread that ran it.
+    fn finished(&self, _rows: &[TrialRow]) -> Result<(), StudyError> {
+        Ok(())
+    }
+}
+
+/// No resume, nothing reported.
+impl Progress for () {}
