@@ -237,14 +237,17 @@ fn no_two_source_files_import_each_other() {
     let pairs: Vec<String> = source_trees(&repo)
         .iter()
         .flat_map(|src| mutual_imports(src))
-        .map(|(a, b)| format!("{} <-> {}", a.strip_prefix(&repo).unwrap().display(), b.strip_prefix(&repo).unwrap().display()))
+        .map(|(a, b)| {
+            format!("{} <-> {}", a.strip_prefix(&repo).unwrap().display(), b.strip_prefix(&repo).unwrap().display())
+        })
         .collect();
     assert!(pairs.is_empty(), "files that import each other: {pairs:#?}");
 }
 
 #[test]
 fn the_import_reader_sees_what_a_module_names() {
-    let code = code_of("use crate::{grid::X, pose};\n// crate::comment::Y\nfn f() { super::sib::g(); x_crate::no(); }\n");
+    let code =
+        code_of("use crate::{grid::X, pose};\n// crate::comment::Y\nfn f() { super::sib::g(); x_crate::no(); }\n");
     assert_eq!(paths_after(&code, "crate::"), vec![vec!["grid".to_string(), "X".into()], vec!["pose".into()]]);
     assert_eq!(paths_after(&code, "super::"), vec![vec!["sib".to_string(), "g".into()]]);
     let re = root_reexports("pub use a::b::{X, Y};\npub use c::Z;\nmod q;");

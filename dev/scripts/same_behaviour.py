@@ -65,7 +65,7 @@ def record(args):
              "--algorithms", "sift,rmap,correlative,cascade", "--seed", "7", "--out", d / "overlap", "--quiet"], log)
 
 
-TIME_WORDS = ("time", "_ms", "seconds", "wall", "elapsed", "duration_s", "real_time", "speed", "peak_memory")
+TIME_WORDS = ("time", "_ms", "ms_per", "seconds", "wall", "elapsed", "duration_s", "real_time", "speed", "peak_memory")
 
 
 def is_time(name):

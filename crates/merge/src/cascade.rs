@@ -108,7 +108,7 @@ impl Merger for Cascade {
         }))
     }
 
-    /// Each stage through the pipeline in turn: [`merge_cascade`].
+    /// Each stage through the pipeline in turn, the first the gate accepts is the merge.
     fn merge(&self, a: &OccupancyGrid, b: &OccupancyGrid, p: &MergeParams) -> MergeOutcome {
         merge_cascade(self, a, b, p)
     }

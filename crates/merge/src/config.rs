@@ -32,9 +32,9 @@ pub struct MergerConfig {
     pub wall_dilation: usize,
     /// Detect and match the two maps' features on two threads (one merge with the machine to itself).
     pub parallel: bool,
-    /// The correlative search's significance margin ([`CorrelativeParams::min_margin`]).
+    /// The correlative search's significance margin ([`AnswerParams::min_margin`](crate::AnswerParams::min_margin)).
     pub min_margin: f64,
-    /// The correlative answer checked by the same search the other way round ([`CorrelativeParams::cross_check`]).
+    /// The correlative answer checked by the same search the other way round ([`AnswerParams::cross_check`](crate::AnswerParams::cross_check)).
     pub cross_check: bool,
     /// Seed of every random draw (the SIFT merger's RANSAC, the R-map's orientation RANSAC).
     pub seed: u64,

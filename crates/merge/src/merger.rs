@@ -13,7 +13,7 @@ use std::collections::BTreeMap;
 use std::time::Instant;
 
 // The correlative search (its own module tree) names these through here.
-pub(crate) use crate::alignment::{Alignment, Evidence, Hypothesis, NoAlignment};
+use crate::alignment::{Alignment, Hypothesis, NoAlignment};
 use crate::merge_params::MergeParams;
 
 /// A map-merging algorithm: finds the transform between two occupancy grids of unknown relative pose.
@@ -159,6 +159,7 @@ pub(crate) fn merge_bounded<M: Merger + ?Sized>(
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
+    use crate::alignment::Evidence;
     use mrslam_core::{Pose2, pose};
 
     /// An algorithm that answers with fixed hypotheses.

@@ -46,7 +46,6 @@ mod sweep;
 mod trial;
 mod wilson;
 
-
 pub use algorithms::{check_algorithms, parse_algorithms};
 pub use error::StudyError;
 pub use outputs::write_outputs;

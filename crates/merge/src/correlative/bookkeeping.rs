@@ -1,13 +1,8 @@
 //! What every stage of the search shares: timings, failures, and the map over candidates on rayon's threads.
 
-use crate::merger::{Evidence, NoAlignment};
+use crate::alignment::{Evidence, NoAlignment};
 use rayon::prelude::*;
 use std::collections::BTreeMap;
-use std::time::Instant;
-
-pub(super) fn ms(t: Instant) -> f64 {
-    t.elapsed().as_secs_f64() * 1e3
-}
 
 /// `f` over `items` in order, on rayon or on this thread, each worker with its own scratch `S`.
 pub(super) fn map_with_scratch<T: Sync, S: Default, R: Send>(

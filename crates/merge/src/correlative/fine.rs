@@ -1,12 +1,13 @@
 //! The fine stage: every global answer and rival refined by a window search on a's own cells, the strongest
 //! polished by wall ICP and scored again; the significance of the best.
 
-use super::bookkeeping::{map_with_scratch, ms};
+use super::bookkeeping::map_with_scratch;
 use super::geometry::{angle_gap, max_displacement, to_scan_pose, to_transform};
 use super::global::Found;
 use super::params::{CorrelativeMerger, CorrelativeParams};
 use super::significance::Significance;
 use crate::refine::{RefineParams, refine, wall_points};
+use crate::timing::ms;
 use mrslam_core::{OccupancyGrid, Pose2};
 use mrslam_matching::{
     BlockStates, HIT, LocalScratch, LocalWindow, ScanPose, ScoreField, WallScan, WindowField, WindowKey, local_search,

@@ -1,11 +1,12 @@
 //! The global search: branch and bound over every translation at each rotation the prior allows, on both maps
 //! pooled to the search cell; optionally screened at a coarser cell first.
 
-use super::bookkeeping::{fail, map_with_scratch, ms};
+use super::bookkeeping::{fail, map_with_scratch};
 use super::geometry::{angle_gap, to_scan_pose, to_transform};
 use super::orientation;
 use super::params::{CorrelativeMerger, CorrelativeParams};
-use crate::merger::NoAlignment;
+use crate::alignment::NoAlignment;
+use crate::timing::ms;
 use mrslam_core::{OccupancyGrid, Pose2};
 use mrslam_matching::{
     Best, BlockStates, Candidate, HIT, LocalScratch, LocalWindow, Pyramid, ScanPose, ScoreField, WallScan, Window,

@@ -1,9 +1,11 @@
 //! The correlative merger behind the pipeline's [`Merger`] interface: its answers, checked the other way round.
 
-use super::bookkeeping::{fail, ms};
+use super::bookkeeping::fail;
 use super::fine::Candidates;
 use super::params::CorrelativeMerger;
-use crate::merger::{Alignment, Evidence, Hypothesis, Merger, NoAlignment};
+use crate::alignment::{Alignment, Evidence, Hypothesis, NoAlignment};
+use crate::merger::Merger;
+use crate::timing::ms;
 use crate::verify::{VerifyParams, wall_hits};
 use mrslam_core::{OccupancyGrid, Pose2};
 use nalgebra::Point2;

@@ -1,14 +1,14 @@
 //! A pair settled: the strict search, the tolerant fallback pooled with it, and the shared-area check; the
 //! probes' views of them.
 
-use super::bookkeeping::ms;
 use super::fine::{Candidates, FineCache, FineField};
 use super::geometry::{to_scan_pose, to_transform};
 use super::global::{Pooled, dense_free_cells};
 use super::orientation;
 use super::params::{CorrelativeMerger, CorrelativeParams, SearchParams};
 use super::significance::Significance;
-use crate::merger::NoAlignment;
+use crate::alignment::NoAlignment;
+use crate::timing::ms;
 use crate::verify::agreement;
 use mrslam_core::{OccupancyGrid, Pose2};
 use mrslam_matching::{HIT, LocalScratch, LocalWindow, ScoreField, WallScan, WindowField, local_search, window_key};
