@@ -100,12 +100,7 @@ pub(super) fn merge_maps(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::path::Path;
-
-    fn two_rooms() -> Scenario {
-        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenarios/paper_two_rooms.toml");
-        Scenario::from_file(&path).unwrap()
-    }
+    use crate::runner::tests::two_rooms;
 
     #[test]
     fn the_host_comes_first_in_the_merge_pair() {

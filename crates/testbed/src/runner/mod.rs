@@ -83,11 +83,12 @@ pub fn run(scenario: &Scenario, mut opts: RunOptions) -> Result<RunOutput, RunEr
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use std::path::Path;
 
-    fn two_rooms() -> Scenario {
+    /// The paper's two-rooms scenario, for the runner's tests.
+    pub(crate) fn two_rooms() -> Scenario {
         let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenarios/paper_two_rooms.toml");
         Scenario::from_file(&path).unwrap()
     }
