@@ -4,7 +4,7 @@ use crate::carmen;
 use crate::error::LogError;
 use crate::options::ReadOptions;
 use crate::sensor_log::SensorLog;
-use std::io::{BufRead, BufReader, Read};
+use std::io::{BufRead, BufReader};
 use std::path::Path;
 
 /// The log formats this crate reads.
@@ -51,15 +51,11 @@ pub fn format_by_content(head: &[u8]) -> Option<Format> {
 /// file.
 pub fn read_log(path: &Path, options: &ReadOptions) -> Result<SensorLog, LogError> {
     let io = |cause| LogError::Io { path: path.to_path_buf(), cause };
-    let mut file = std::fs::File::open(path).map_err(io)?;
-    let mut magic = [0u8; 2];
-    let n = file.read(&mut magic).map_err(io)?;
-    let file = std::fs::File::open(path).map_err(io)?;
-    let mut reader: Box<dyn BufRead> = if n == 2 && magic == GZIP_MAGIC {
-        Box::new(BufReader::new(flate2::read::MultiGzDecoder::new(file)))
-    } else {
-        Box::new(BufReader::new(file))
-    };
+    let mut file = BufReader::new(std::fs::File::open(path).map_err(io)?);
+    // The magic is peeked at, not consumed: the file is opened once.
+    let gzipped = file.fill_buf().map_err(io)?.starts_with(&GZIP_MAGIC);
+    let mut reader: Box<dyn BufRead> =
+        if gzipped { Box::new(BufReader::new(flate2::read::MultiGzDecoder::new(file))) } else { Box::new(file) };
     let format = match format_by_extension(path) {
         Some(format) => format,
         None => {
