@@ -205,9 +205,16 @@ pub fn run(args: SlamArgs) -> Result<ExitCode> {
     let start = std::time::Instant::now();
     let mut index = 0;
     let mut first_slam = None;
+    let mut reanchors = 0;
     let run = map_log(&mut filter, odo.iter().zip(log.scans.iter().map(|r| &r.scan)), |out, filter| {
         if let Some(neff) = out.neff() {
-            bar.set_message(format!("Neff {neff:.1}"));
+            bar.set_message(match filter.loop_report() {
+                Some(l) => format!(
+                    "Neff {neff:.1}, loops: {} searched, {} kept, {} open",
+                    l.candidates, l.closures, l.open_loops
+                ),
+                None => format!("Neff {neff:.1}"),
+            });
         }
         bar.inc(1);
         if let Some(v) = viz.as_mut() {
@@ -226,6 +233,17 @@ pub fn run(args: SlamArgs) -> Result<ExitCode> {
                     resampled: out.resampled(),
                     realtime_factor: (elapsed > 0.0).then(|| (scan.stamp - stamp0) / elapsed),
                 });
+            }
+            if filter.counters().reanchors > reanchors {
+                reanchors = filter.counters().reanchors;
+                let path: Vec<Pose2> = filter.trajectory().into_iter().map(|(_, p)| p).collect();
+                let edges: Vec<(Pose2, Pose2)> = filter.loop_edges().into_iter().map(|(a, b)| (path[a], path[b])).collect();
+                let l = filter.loop_report().unwrap_or_default();
+                let text = format!(
+                    "loop closed: {} loop edges kept; the trajectory moved by up to {:.2} m",
+                    l.closures, l.max_correction
+                );
+                v.loops_closed(&path, &edges, &text);
             }
             if let Some(odom) = filter.odometry_pose() {
                 v.odometry(&odom, first_slam.as_ref());
@@ -325,11 +343,14 @@ pub fn run(args: SlamArgs) -> Result<ExitCode> {
         println!("scan odometry: {matched} scans matched, {dead} kept the raw odometry's increment");
     }
     if let Some(l) = &loops {
-        println!(
-            "loop closure: {} of {} processed scans matched a place passed a loop ago; {} loop edges; the \
-             smoothing moved a scan by at most {:.2} m ({} iterations)",
-            l.candidates, c.processed, l.closures, l.max_correction, l.iterations
-        );
+        println!("loop closure: {}", describe_loops(l, filter.params().loop_closure.online, c.processed));
+        if l.open_loops > 0 {
+            println!(
+                "warning: {} stretch(es) of driving through places passed a loop ago found no loop edge: the map \
+                 may show those places twice",
+                l.open_loops
+            );
+        }
     }
     if filter.params().filter.odometry_calibration > 0.0 {
         let [scale, heading] = filter.odometry_calibration();
@@ -380,16 +401,40 @@ pub fn run(args: SlamArgs) -> Result<ExitCode> {
                 json!({ "matched": matched, "raw": dead })
             }),
             "loop_closure": loops.map(|l| json!({
+                "online": filter.params().loop_closure.online,
                 "candidates": l.candidates,
                 "closures": l.closures,
+                "rejected": l.rejected,
+                "dropped": l.dropped,
+                "optimisations": l.optimisations,
+                "open_loops": l.open_loops,
                 "max_correction_m": l.max_correction,
                 "iterations": l.iterations,
+                "reanchors": c.reanchors,
             })),
             "metric": score.as_ref().map(|s| super::eval::to_json(s, args.tolerance, 10)),
         });
         super::eval::write_json(path, &summary)?;
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// One line on what loop closure did.
+fn describe_loops(l: &mrslam_slam::LoopClosureReport, online: bool, processed: usize) -> String {
+    if online {
+        format!(
+            "{} searches of {processed} processed scans against places passed a loop ago: {} loop edges kept, {} \
+             found nothing, {} dropped as inconsistent; {} optimisations moved a scan by at most {:.2} m; {} loops \
+             left open",
+            l.candidates, l.closures, l.rejected, l.dropped, l.optimisations, l.max_correction, l.open_loops
+        )
+    } else {
+        format!(
+            "{} of {processed} processed scans matched a place passed a loop ago; {} loop edges; the smoothing moved \
+             a scan by at most {:.2} m ({} iterations)",
+            l.candidates, l.closures, l.max_correction, l.iterations
+        )
+    }
 }
 
 /// Records the end of the run: the loop closure, the final paths (smoothed), the output map, the relations.
@@ -405,11 +450,8 @@ fn record_the_end(
     let last = scans.len() - 1;
     v.set_time(last as u64, scans[last].scan.stamp - stamp0);
     if let Some(l) = &run.loop_closure {
-        let level = if l.closures > 0 { Level::Info } else { Level::Warn };
-        let text = format!(
-            "loop closure: {} scans matched a place passed a loop ago, {} loop edges; a scan moved by at most {:.2} m",
-            l.candidates, l.closures, l.max_correction
-        );
+        let level = if l.closures > 0 && l.open_loops == 0 { Level::Info } else { Level::Warn };
+        let text = format!("loop closure: {}", describe_loops(l, filter.params().loop_closure.online, run.processed.len()));
         v.event(level, &text);
     }
     let smoothed: Vec<Pose2> = filter.trajectory().into_iter().map(|(_, p)| p).collect();

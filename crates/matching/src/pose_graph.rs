@@ -93,7 +93,9 @@ pub fn optimize(poses: &mut [Xyt], edges: &[Edge], max_iterations: u32) -> Optio
     if n < 2 || edges.is_empty() {
         return Some(Solution { iterations: 0, cost_before, cost_after: cost_before });
     }
-    let dim = 3 * (n - 1); // node k > 0 owns variables 3(k-1)..3k
+    let dim = 3 * (n - 1);
+    // Node k > 0 owns variables 3·slot[k]..3·slot[k] + 3, in a fill-reducing order.
+    let slot = elimination_order(n, edges);
     let mut current = poses.to_vec();
     let mut iterations = 0;
     for _ in 0..max_iterations {
@@ -108,14 +110,14 @@ pub fn optimize(poses: &mut [Xyt], edges: &[Edge], max_iterations: u32) -> Optio
             let err = Vector3::from(err);
             let blocks = [(e.from, Matrix3::from(ji).transpose()), (e.to, Matrix3::from(jj).transpose())];
             for &(na, ja) in &blocks {
-                let Some(va) = na.checked_sub(1).map(|k| 3 * k) else { continue };
+                let Some(va) = slot[na].map(|k| 3 * k) else { continue };
                 let jt_o = ja.transpose() * o; // Jₐᵀ Ω
                 let g = jt_o * err * w;
                 for r in 0..3 {
                     b[va + r] -= g[r];
                 }
                 for &(nb, jb) in &blocks {
-                    let Some(vb) = nb.checked_sub(1).map(|k| 3 * k) else { continue };
+                    let Some(vb) = slot[nb].map(|k| 3 * k) else { continue };
                     let block = jt_o * jb * w; // Jₐᵀ Ω J_b
                     for ((r, c), &v) in (0..3).flat_map(|c| (0..3).map(move |r| (r, c))).zip(block.iter()) {
                         if v != 0.0 {
@@ -136,7 +138,7 @@ pub fn optimize(poses: &mut [Xyt], edges: &[Edge], max_iterations: u32) -> Optio
         let step = chol.solve(&b);
         let mut largest: f64 = 0.0;
         for (k, p) in current.iter_mut().enumerate().skip(1) {
-            let v = 3 * (k - 1);
+            let Some(v) = slot[k].map(|s| 3 * s) else { continue };
             let (dx, dy, dt) = (step[v], step[v + 1], step[v + 2]);
             if !(dx.is_finite() && dy.is_finite() && dt.is_finite()) {
                 return None;
@@ -153,6 +155,47 @@ pub fn optimize(poses: &mut [Xyt], edges: &[Edge], max_iterations: u32) -> Optio
     let cost_after = cost(&current, edges);
     poses.copy_from_slice(&current);
     Some(Solution { iterations, cost_before, cost_after })
+}
+
+/// Each node's place in the elimination order (node 0, held fixed, has none): greedy minimum degree on the
+/// graph of the edges (Tinney's scheme 2, the idea behind AMD). In time order a loop edge fills the factor
+/// across its whole span, and a log full of loops factors nearly dense; eliminating the least connected node
+/// first keeps the factor of a chain with loops sparse.
+fn elimination_order(n: usize, edges: &[Edge]) -> Vec<Option<usize>> {
+    use std::cmp::Reverse;
+    use std::collections::BinaryHeap;
+    let mut adjacent: Vec<Vec<usize>> = vec![Vec::new(); n];
+    for e in edges {
+        if e.from != 0 && e.to != 0 {
+            adjacent[e.from].push(e.to);
+            adjacent[e.to].push(e.from);
+        }
+    }
+    for a in &mut adjacent {
+        a.sort_unstable();
+        a.dedup();
+    }
+    let mut slot = vec![None; n];
+    let mut heap: BinaryHeap<Reverse<(usize, usize)>> = (1..n).map(|k| Reverse((adjacent[k].len(), k))).collect();
+    let mut next = 0;
+    while let Some(Reverse((degree, v))) = heap.pop() {
+        if slot[v].is_some() || degree != adjacent[v].len() {
+            continue;
+        }
+        slot[v] = Some(next);
+        next += 1;
+        // Eliminating v joins its neighbours into a clique.
+        let neighbours = std::mem::take(&mut adjacent[v]);
+        for &u in &neighbours {
+            let a = &mut adjacent[u];
+            a.retain(|&w| w != v);
+            a.extend(neighbours.iter().copied().filter(|&w| w != u));
+            a.sort_unstable();
+            a.dedup();
+            heap.push(Reverse((a.len(), u)));
+        }
+    }
+    slot
 }
 
 #[cfg(test)]

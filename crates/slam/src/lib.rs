@@ -48,6 +48,7 @@ mod error;
 mod every_scan;
 mod field;
 mod loop_closure;
+mod loop_graph;
 mod map_build;
 mod motion;
 mod outcome;

@@ -65,6 +65,36 @@ pub struct LoopClosureParams {
     /// `loop_range`, metres: beams longer than this (or than the map's `max_urange`) are not used by the loop
     /// matches.
     pub range: f64,
+    /// `loop_online`: close loops while the robot drives (a pose graph searched at every processed scan and
+    /// optimised as loops are found, the filter re-anchored on it; see `loop_graph`); off: only when the log
+    /// ends, by local searches around the filter's trajectory (see `loop_closure`).
+    pub online: bool,
+    /// `loop_submap_scans`: processed scans per submap of the online graph.
+    pub submap_scans: usize,
+    /// `loop_window_per_metre`: the online search's translation window grows by this many metres per metre
+    /// driven since the last closure (or since the submap), from `loop_window`; wider once a closure showed
+    /// more drift.
+    pub window_per_metre: f64,
+    /// `loop_heading_window_per_metre`, radians per metre: the same for the heading window, from
+    /// `loop_heading_window`.
+    pub heading_window_per_metre: f64,
+    /// `loop_max_window`, metres: the translation window is never wider than this.
+    pub max_window: f64,
+    /// `loop_max_heading_window`, radians: the heading window is never wider than this.
+    pub max_heading_window: f64,
+    /// `loop_min_score`: the branch and bound keeps a pose whose scan points score at least this on average (1 on
+    /// a wall of the submap, falling as a Gaussian of the distance, σ 2 cells).
+    pub min_score: f64,
+    /// `loop_max_searches`: submaps a processed scan is searched against at most (the nearest).
+    pub max_searches: usize,
+    /// `loop_optimize_every`: processed scans between optimisations while loop edges wait.
+    pub optimize_every: usize,
+    /// `loop_max_residual`: once optimised, loop edges farther than this Mahalanobis distance from the graph's
+    /// poses are dropped (worst first).
+    pub max_residual: f64,
+    /// `loop_open_travel`, metres: driving this far through places passed a loop ago without a loop edge is a
+    /// loop left open (counted in the report).
+    pub open_loop_travel: f64,
 }
 
 impl Default for LoopClosureParams {
@@ -82,6 +112,17 @@ impl Default for LoopClosureParams {
             sigma: 0.02,
             heading_sigma: 0.005,
             range: 30.0,
+            online: true,
+            submap_scans: 15,
+            window_per_metre: 0.03,
+            heading_window_per_metre: 0.003,
+            max_window: 10.0,
+            max_heading_window: 0.8,
+            min_score: 0.55,
+            max_searches: 3,
+            optimize_every: 10,
+            max_residual: 10.0,
+            open_loop_travel: 10.0,
         }
     }
 }
@@ -89,10 +130,19 @@ impl Default for LoopClosureParams {
 /// What loop closure did.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct LoopClosureReport {
-    /// Processed scans that had a place passed a loop ago within `loop_search_radius`, and were matched there.
+    /// Loop searches made: a processed scan matched against a place passed a loop ago.
     pub candidates: usize,
-    /// Matches accepted as loop edges.
+    /// Matches kept as loop edges.
     pub closures: usize,
+    /// Searches that found no match good enough.
+    pub rejected: usize,
+    /// Matches accepted, then dropped by the graph as inconsistent with the others (online only).
+    pub dropped: usize,
+    /// Optimisations run (online only).
+    pub optimisations: usize,
+    /// Stretches of at least `loop_open_travel` metres through places passed a loop ago in which no loop edge
+    /// was found (online only): a map with such a stretch may show a place twice.
+    pub open_loops: usize,
     /// Largest move of a processed scan's pose by the optimisation, metres.
     pub max_correction: f64,
     /// Gauss-Newton iterations of the optimisation.
@@ -100,7 +150,7 @@ pub struct LoopClosureReport {
 }
 
 /// Huber's threshold on a loop edge's Mahalanobis distance.
-const LOOP_HUBER: f64 = 3.0;
+pub(crate) const LOOP_HUBER: f64 = 3.0;
 /// Gauss-Newton iterations at most.
 const MAX_ITERATIONS: u32 = 30;
 /// Beams of the translation and heading search: every this many (the climb and Gauss-Newton use all).
@@ -155,6 +205,7 @@ pub fn close_loops(
         })
         .collect();
     report.closures = loops.len();
+    report.rejected = report.candidates - report.closures;
     if loops.is_empty() {
         return (poses, report);
     }
@@ -261,7 +312,7 @@ fn match_loop(
 /// A loop edge's information from the scan's information `h` about the robot's pose (map frame): rotated into
 /// the robot's frame at heading `theta`, its covariance widened by `loop_sigma` and `loop_heading_sigma` (the
 /// matcher's information counts every beam as independent, which they are not).
-fn loop_information(h: &Information, theta: f64, params: &LoopClosureParams) -> Information {
+pub(crate) fn loop_information(h: &Information, theta: f64, params: &LoopClosureParams) -> Information {
     let (s, c) = theta.sin_cos();
     // Rᵀ H R for the translation block, Rᵀ h_tθ for the coupling.
     let m = h.matrix();
@@ -279,14 +330,14 @@ fn loop_information(h: &Information, theta: f64, params: &LoopClosureParams) -> 
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::synthetic::{self, Drift, Lidar};
     use mrslam_core::{Pose2, pose};
     use std::sync::Arc;
 
     /// The office loop seen by a SICK-class lidar from the true poses, a node every metre or quarter turn.
-    fn office_nodes() -> (Vec<Pose2>, Vec<Arc<mrslam_core::LaserScan>>, Xyt) {
+    pub(crate) fn office_nodes() -> (Vec<Pose2>, Vec<Arc<mrslam_core::LaserScan>>, Xyt) {
         let path = synthetic::waypoint_path(&synthetic::office_loop(), 0.05, 0.1);
         let run = synthetic::simulate(
             &synthetic::office_map(),
@@ -322,7 +373,8 @@ mod tests {
             .collect()
     }
 
-    fn error_to(truth: &[Pose2], poses: &[Xyt]) -> (f64, f64) {
+    /// The largest and the last distance between `truth` and `poses`.
+    pub(crate) fn error_to(truth: &[Pose2], poses: &[Xyt]) -> (f64, f64) {
         let e: Vec<f64> =
             truth.iter().zip(poses).map(|(t, p)| (t.translation.x - p.x).hypot(t.translation.y - p.y)).collect();
         (e.iter().copied().fold(0.0, f64::max), e[e.len() - 1])

@@ -73,4 +73,6 @@ pub struct Counters {
     pub invalid_beams: usize,
     /// Resampling steps.
     pub resamples: usize,
+    /// Times the particles were re-anchored on the online loop-closure graph (their maps redrawn from it).
+    pub reanchors: usize,
 }

@@ -168,6 +168,17 @@ pub const FLAT_NAMES: &[(&str, &str)] = &[
     ("loop_sigma", "loop_closure.sigma"),
     ("loop_heading_sigma", "loop_closure.heading_sigma"),
     ("loop_range", "loop_closure.range"),
+    ("loop_online", "loop_closure.online"),
+    ("loop_submap_scans", "loop_closure.submap_scans"),
+    ("loop_window_per_metre", "loop_closure.window_per_metre"),
+    ("loop_heading_window_per_metre", "loop_closure.heading_window_per_metre"),
+    ("loop_max_window", "loop_closure.max_window"),
+    ("loop_max_heading_window", "loop_closure.max_heading_window"),
+    ("loop_min_score", "loop_closure.min_score"),
+    ("loop_max_searches", "loop_closure.max_searches"),
+    ("loop_optimize_every", "loop_closure.optimize_every"),
+    ("loop_max_residual", "loop_closure.max_residual"),
+    ("loop_open_travel", "loop_closure.open_loop_travel"),
 ];
 
 impl SlamParams {
@@ -394,6 +405,27 @@ impl SlamParams {
         pos("loop_closure.chain_heading_sigma", lc.chain_heading_sigma)?;
         pos("loop_closure.sigma", lc.sigma)?;
         pos("loop_closure.heading_sigma", lc.heading_sigma)?;
+        if !(1..=10_000).contains(&lc.submap_scans) {
+            return invalid("loop_closure.submap_scans", format!("must be in 1..=10000, got {}", lc.submap_scans));
+        }
+        nonneg("loop_closure.window_per_metre", lc.window_per_metre)?;
+        nonneg("loop_closure.heading_window_per_metre", lc.heading_window_per_metre)?;
+        nonneg("loop_closure.max_window", lc.max_window)?;
+        if lc.max_window / m.delta > 4000.0 {
+            return invalid("loop_closure.max_window", "/ map.delta must be at most 4000 cells".into());
+        }
+        nonneg("loop_closure.max_heading_window", lc.max_heading_window)?;
+        if lc.max_heading_window > std::f64::consts::PI {
+            return invalid("loop_closure.max_heading_window", "must be at most pi".into());
+        }
+        if !(lc.min_score.is_finite() && lc.min_score > 0.0 && lc.min_score <= 1.0) {
+            return invalid("loop_closure.min_score", format!("must be in (0, 1], got {}", lc.min_score));
+        }
+        if lc.max_searches > 100 {
+            return invalid("loop_closure.max_searches", format!("must be at most 100, got {}", lc.max_searches));
+        }
+        pos("loop_closure.max_residual", lc.max_residual)?;
+        nonneg("loop_closure.open_loop_travel", lc.open_loop_travel)?;
         if !(m.occ_thresh.is_finite() && (0.0..1.0).contains(&m.occ_thresh)) {
             return invalid("map.occ_thresh", format!("must be in [0, 1), got {}", m.occ_thresh));
         }

@@ -7,7 +7,7 @@ use std::sync::Arc;
 
 /// One processed scan of a particle's trajectory. Nodes are shared between particles descending from a
 /// common ancestor, so N trajectories cost one tree.
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 pub struct TrajectoryNode {
     /// Stamp of the scan, seconds.
     pub stamp: f64,

@@ -4,14 +4,16 @@ use crate::backend::{Correction, Hypotheses, SlamBackend};
 use crate::calibration::{CalibrationMatch, OdometryCalibration};
 use crate::error::SlamError;
 use crate::loop_closure::LoopClosureReport;
+use crate::loop_graph::LoopGraph;
 use crate::map_build::build_map;
 use crate::motion::MotionModel;
 use crate::outcome::{Counters, SkipReason, UpdateOutcome, UpdateStats};
 use crate::params::SlamParams;
 use crate::particle::{Particle, TrajectoryNode, ancestry};
 use crate::resample::{normalize, systematic};
-use crate::scan_matcher::{MatchInformation, MatchResult, MotionPrior, PreparedScan, ScanMatcher, Scratch};
+use crate::scan_matcher::{Beam, MatchInformation, MatchResult, MotionPrior, PreparedScan, ScanMatcher, Scratch};
 use crate::scan_odometry::ScanOdometry;
+use crate::tile_map::{TileMap, TooLarge};
 use mrslam_core::{LaserScan, OccupancyGrid, Odometry, Pose2};
 use mrslam_core::{Xyt, pose::relative};
 use rand::{Rng, SeedableRng};
@@ -91,8 +93,12 @@ pub struct Rbpf {
     /// Scan-matched odometry (see [`SlamParams::scan_odometry`]).
     scan_odometry: Option<ScanOdometry>,
     counters: Counters,
-    /// Trajectory poses moved by [`Rbpf::close_loops`], not yet taken ([`SlamBackend::take_corrections`]).
+    /// Trajectory poses moved by [`Rbpf::close_loops`] or the online graph, not yet taken
+    /// ([`SlamBackend::take_corrections`]).
     corrections: Vec<Correction>,
+    /// The online loop closure's pose graph (`loop_closure.enabled` and `loop_closure.online`): the
+    /// trajectory and the output map are its; the particles are re-anchored on it when it moves.
+    graph: Option<LoopGraph>,
 }
 
 impl Rbpf {
@@ -106,6 +112,8 @@ impl Rbpf {
         let matcher = ScanMatcher::new(params.matcher, laser, params.filter.odometry_calibration > 0.0);
         let motion = params.motion;
         let n = params.filter.particles;
+        let graph = (params.loop_closure.enabled && params.loop_closure.online)
+            .then(|| LoopGraph::new(params.loop_closure, &params.matcher, params.map, laser));
         let scan_odometry = params
             .scan_odometry
             .enabled
@@ -131,6 +139,7 @@ impl Rbpf {
             scan_odometry,
             counters: Counters::default(),
             corrections: Vec::new(),
+            graph,
         })
     }
 
@@ -336,43 +345,19 @@ impl Rbpf {
         self.resampled_last = resampled;
 
         // Map the scan in every particle and extend its trajectory (in parallel: each particle's map is its
-        // own). The seen band of a beam whose end point lies within half a cell of the last banded beam's
-        // adds nothing at this resolution and is skipped (the same beams for every particle).
+        // own).
         let shared_scan = Arc::new(scan.clone());
         let band = self.params.matcher.seen_band;
-        let mut banded = vec![false; prepared.hits.len()];
-        if band > 0.0 {
-            let gap = 0.5 * self.params.map.delta;
-            let mut last: Option<(f64, f64)> = None;
-            for (flag, b) in banded.iter_mut().zip(&prepared.hits) {
-                if last.is_none_or(|(x, y)| (b.x - x) * (b.x - x) + (b.y - y) * (b.y - y) >= gap * gap) {
-                    *flag = true;
-                    last = Some((b.x, b.y));
-                }
-            }
-        }
+        let banded = banded_beams(&prepared, band, self.params.map.delta);
         let matcher = &self.matcher;
-        let hits = &prepared.hits;
-        let banded = &banded;
+        let (hits, banded) = (&prepared.hits, &banded);
         let mapped: Result<(), SlamError> = self.particles.par_iter_mut().try_for_each(|part| {
-            let lp = matcher.laser_pose(&part.pose);
-            let (s, c) = lp.theta.sin_cos();
-            let too_large = |part: &Particle| {
+            draw_scan(&mut part.map, &matcher.laser_pose(&part.pose), hits, banded, band).map_err(|_| {
                 SlamError::MapTooLarge(format!(
                     "a particle at ({:.1}, {:.1}) m left the largest map supported",
                     part.pose.x, part.pose.y
                 ))
-            };
-            for (b, &band_it) in hits.iter().zip(banded) {
-                let (dx, dy) = (c * b.c - s * b.s, s * b.c + c * b.s);
-                let (ex, ey) = (lp.x + b.r * dx, lp.y + b.r * dy);
-                if band_it {
-                    let r0 = (b.r - band).max(0.0);
-                    let (x0, y0) = (lp.x + r0 * dx, lp.y + r0 * dy);
-                    part.map.mark_seen(x0, y0, ex + band * dx, ey + band * dy).map_err(|_| too_large(part))?;
-                }
-                part.map.add_beam_hit(ex, ey, dx, dy).map_err(|_| too_large(part))?;
-            }
+            })?;
             part.node = Some(Arc::new(TrajectoryNode {
                 stamp: scan.stamp,
                 pose: part.pose,
@@ -382,6 +367,7 @@ impl Rbpf {
             Ok(())
         });
         mapped?;
+        self.add_to_graph(scan.stamp, &shared_scan)?;
         self.linear_distance = 0.0;
         self.angular_distance = 0.0;
         self.motion_var = [0.0; 3];
@@ -398,6 +384,56 @@ impl Rbpf {
             invalid_beams: prepared.invalid,
             best: self.best_index(),
         }))
+    }
+
+    /// Adds the best particle's new node to the online graph (when there is one) and re-anchors the particles
+    /// on the graph when its optimisation moved the trajectory.
+    fn add_to_graph(&mut self, stamp: f64, scan: &Arc<LaserScan>) -> Result<(), SlamError> {
+        let best = self.best_index();
+        let Some(graph) = self.graph.as_mut() else { return Ok(()) };
+        let Some(node) = self.particles[best].node.as_ref() else { return Ok(()) };
+        let increment = match &node.parent {
+            Some(parent) => Xyt::from_pose(&relative(&parent.pose.to_pose(), &node.pose.to_pose())),
+            None => node.pose,
+        };
+        if graph.add(stamp, increment, scan.clone()) {
+            self.reanchor()?;
+        }
+        Ok(())
+    }
+
+    /// Redraws the particles' maps from the graph's poses (one map, shared) and moves every particle by the
+    /// correction at the newest node, so that the filter goes on in the loop-closed map.
+    fn reanchor(&mut self) -> Result<(), SlamError> {
+        let best = self.best_index();
+        let Some(graph) = self.graph.as_mut() else { return Ok(()) };
+        let (Some(node), Some(last)) = (self.particles[best].node.clone(), graph.nodes().last()) else {
+            return Ok(());
+        };
+        let (stamp, pose, scan) = (last.stamp, last.pose, last.scan.clone());
+        let shift = pose.to_pose() * node.pose.to_pose().inverse();
+        let p = &self.params;
+        let band = p.matcher.seen_band;
+        let mut map = TileMap::new(p.map.delta);
+        for n in graph.nodes() {
+            let prepared =
+                PreparedScan::new(&n.scan, p.map.max_range.min(n.scan.range_max as f64), p.map.max_urange, 0);
+            let banded = banded_beams(&prepared, band, p.map.delta);
+            draw_scan(&mut map, &self.matcher.laser_pose(&n.pose), &prepared.hits, &banded, band)
+                .map_err(|_| SlamError::MapTooLarge("the loop-closed map left the largest map supported".into()))?;
+        }
+        for (n, before) in graph.moved_since_drawn() {
+            self.corrections.push(Correction { stamp: n.stamp, before: before.to_pose(), after: n.pose.to_pose() });
+        }
+        graph.mark_drawn();
+        let newest = Arc::new(TrajectoryNode { stamp, pose, scan, parent: None });
+        for part in &mut self.particles {
+            part.pose = Xyt::from_pose(&(shift * part.pose.to_pose()));
+            part.map = map.clone();
+            part.node = Some(newest.clone());
+        }
+        self.counters.reanchors += 1;
+        Ok(())
     }
 
     /// One step of the odometry calibration (see [`OdometryCalibration`]) from the matches of this update:
@@ -442,9 +478,14 @@ impl Rbpf {
         best
     }
 
-    /// Current pose of the best particle (map frame), including motion since the last processed scan.
+    /// Current pose of the best particle (map frame), including motion since the last processed scan; with the
+    /// online graph, its move since its last node is carried from the graph's newest node.
     pub fn best_pose(&self) -> Pose2 {
-        self.particles[self.best_index()].pose.to_pose()
+        let part = &self.particles[self.best_index()];
+        match (self.graph.as_ref().and_then(|g| g.nodes().last()), part.node.as_ref()) {
+            (Some(last), Some(node)) => last.pose.to_pose() * relative(&node.pose.to_pose(), &part.pose.to_pose()),
+            _ => part.pose.to_pose(),
+        }
     }
 
     /// The particles' current poses and normalised weights (for visualisation).
@@ -467,9 +508,23 @@ impl Rbpf {
         self.counters
     }
 
-    /// The best particle's path: (stamp, robot pose in the map frame) per processed scan, oldest first.
+    /// The best particle's path: (stamp, robot pose in the map frame) per processed scan, oldest first; with
+    /// the online graph, the graph's optimised poses.
     pub fn trajectory(&self) -> Vec<(f64, Pose2)> {
-        self.particle_trajectory(self.best_index())
+        match &self.graph {
+            Some(g) => g.nodes().iter().map(|n| (n.stamp, n.pose.to_pose())).collect(),
+            None => self.particle_trajectory(self.best_index()),
+        }
+    }
+
+    /// The online graph's loop edges as (older, newer) processed-scan indices; empty without the graph.
+    pub fn loop_edges(&self) -> Vec<(usize, usize)> {
+        self.graph.as_ref().map_or_else(Vec::new, |g| g.loop_edges().collect())
+    }
+
+    /// What loop closure did so far (the online graph's report; the end-of-log closure reports at the end).
+    pub fn loop_report(&self) -> Option<LoopClosureReport> {
+        self.graph.as_ref().map(|g| g.report())
     }
 
     /// Particle `i`'s path (see [`Rbpf::trajectory`]); empty when there is no such particle.
@@ -537,7 +592,10 @@ impl Rbpf {
     /// Rebuilt from the best particle's trajectory on every call (like GMapping's ROS node does every
     /// `map_update_interval`): cost grows with the scans processed, so call it when a map is needed.
     pub fn map(&self) -> Result<OccupancyGrid, SlamError> {
-        let nodes: Vec<&TrajectoryNode> = ancestry(&self.particles[self.best_index()].node).collect();
+        let nodes: Vec<&TrajectoryNode> = match &self.graph {
+            Some(g) => g.nodes().iter().collect(),
+            None => ancestry(&self.particles[self.best_index()].node).collect(),
+        };
         build_map(&nodes, &self.laser, &self.params.map)
             .ok_or_else(|| SlamError::MapTooLarge("the trajectory's map exceeds core's grid size limit".into()))
     }
@@ -587,6 +645,16 @@ impl SlamBackend for Rbpf {
     }
 
     fn finish(&mut self) -> Option<LoopClosureReport> {
+        if let Some(g) = self.graph.as_mut() {
+            if g.finish() {
+                // The last optimisation's corrections; the particles are not redrawn (no reading follows).
+                for (n, before) in g.moved_since_drawn() {
+                    self.corrections.push(Correction { stamp: n.stamp, before: before.to_pose(), after: n.pose.to_pose() });
+                }
+                g.mark_drawn();
+            }
+            return Some(g.report());
+        }
         self.params.loop_closure.enabled.then(|| self.close_loops())
     }
 
@@ -621,4 +689,37 @@ impl SlamBackend for Rbpf {
     fn counters(&self) -> Counters {
         self.counters
     }
+}
+
+/// Which of a scan's hits also mark their seen band: a beam whose end point lies within half a cell of the last
+/// banded beam's adds nothing at this resolution and is skipped (the same beams for every particle).
+fn banded_beams(prepared: &PreparedScan, band: f64, delta: f64) -> Vec<bool> {
+    let mut banded = vec![false; prepared.hits.len()];
+    if band > 0.0 {
+        let gap = 0.5 * delta;
+        let mut last: Option<(f64, f64)> = None;
+        for (flag, b) in banded.iter_mut().zip(&prepared.hits) {
+            if last.is_none_or(|(x, y)| (b.x - x) * (b.x - x) + (b.y - y) * (b.y - y) >= gap * gap) {
+                *flag = true;
+                last = Some((b.x, b.y));
+            }
+        }
+    }
+    banded
+}
+
+/// Draws a scan's `hits` from laser pose `lp` into `map`: each end point, and the seen band of the `banded` ones.
+fn draw_scan(map: &mut TileMap, lp: &Xyt, hits: &[Beam], banded: &[bool], band: f64) -> Result<(), TooLarge> {
+    let (s, c) = lp.theta.sin_cos();
+    for (b, &band_it) in hits.iter().zip(banded) {
+        let (dx, dy) = (c * b.c - s * b.s, s * b.c + c * b.s);
+        let (ex, ey) = (lp.x + b.r * dx, lp.y + b.r * dy);
+        if band_it {
+            let r0 = (b.r - band).max(0.0);
+            let (x0, y0) = (lp.x + r0 * dx, lp.y + r0 * dy);
+            map.mark_seen(x0, y0, ex + band * dx, ey + band * dy)?;
+        }
+        map.add_beam_hit(ex, ey, dx, dy)?;
+    }
+    Ok(())
 }

@@ -55,6 +55,9 @@ pub struct RelationMark {
     pub rotation: f64,
 }
 
+/// Colour of the loop edges.
+const LOOP_EDGE: Rgba = [255, 140, 0, 200];
+
 /// Translational error drawn brightest on the path, metres.
 const RELATION_SCALE_M: f64 = 0.2;
 
@@ -166,6 +169,20 @@ impl SlamLogRecorder {
         let (name, c) = (self.name.clone(), self.color);
         self.rec.log_path(&paths::robot(&name, &["odom", "path"]), &self.odom_path, with_alpha(lighten(c, 0.5), 200));
         self.rec.log_path(&paths::robot(&name, &["slam", "path"]), &self.slam_path, lighten(c, 0.25));
+    }
+
+    /// The online loop closure moved the trajectory: the SLAM path is replaced by `path` at once, the loop edges
+    /// (older node, newer node) are drawn as segments, and an event says what changed.
+    pub fn loops_closed(&mut self, path: &[Pose2], edges: &[(Pose2, Pose2)], text: &str) {
+        let name = self.name.clone();
+        self.paths(Some(path));
+        let segments: Vec<(Point2<f64>, Point2<f64>)> =
+            edges.iter().map(|(a, b)| (a.translation.vector.into(), b.translation.vector.into())).collect();
+        let colors = vec![LOOP_EDGE; segments.len()];
+        self.rec.log_matches(&paths::robot(&name, &["slam", "loop_edges"]), &segments, &colors);
+        self.rec.log_event(Level::Info, text);
+        self.map_dirty = true;
+        self.next_map = self.rec.sim_time();
     }
 
     /// True when the growing map is due (processed scans since the last one, and the period has passed).

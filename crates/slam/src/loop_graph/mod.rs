@@ -1,0 +1,395 @@
+//! Loop closure while the robot drives: a pose graph over the filter's processed scans, searched for loops
+//! at every scan and optimised as they are found.
+//!
+//! Not in GMapping; the shape of graph SLAM's back ends (Hess et al. 2016): each processed scan is a node,
+//! chained to the one before by the filter's own increment (the best particle's move between its two
+//! nodes); consecutive nodes are grouped into submaps of `submap_scans`; each new node is searched against
+//! the finished submaps it may be in, passed at least `loop_min_travel` metres of driving ago, by branch and
+//! bound over a window around where the graph puts it, a window that grows with the driving since the last
+//! closure (a loop's drift grows with its length) at the rate the log's own closures showed, never below
+//! the `window_per_metre` one. A match whose mean score reaches `min_score` and whose refinement matches
+//! `min_matched` of the beams becomes a loop edge (the matcher's information, Huber's kernel); the graph is
+//! optimised a few nodes later, and loop edges it cannot reconcile (a Mahalanobis distance above
+//! `max_residual` once optimised) are dropped, worst first. The filter is then re-anchored on the graph
+//! (see [`crate::Rbpf`]): its map is redrawn from the optimised poses, so the map it matches against, and
+//! the one it outputs, are loop-closed at every moment.
+
+mod search;
+mod submap;
+
+use crate::loop_closure::{LoopClosureParams, LoopClosureReport};
+use crate::map_build::MapParams;
+use crate::particle::TrajectoryNode;
+use crate::scan_matcher::{MatcherParams, PreparedScan, ScanMatcher};
+use mrslam_core::{LaserScan, Xyt};
+use mrslam_matching::Information;
+use mrslam_matching::pose_graph::{Edge, optimize};
+use search::{SearchWindow, branch_and_bound_pose, refine_to_edge, search_points};
+use std::sync::Arc;
+use submap::{GridCache, Submap, SubmapGrids, in_anchor_frame};
+
+/// Gauss-Newton iterations of an optimisation while driving at most (it starts from the last optimum, so a
+/// few suffice; each factorises the whole graph, the costliest step of the loop closure).
+const ONLINE_ITERATIONS: u32 = 4;
+/// Gauss-Newton iterations of the optimisation at the end of the data at most.
+const FINAL_ITERATIONS: u32 = 20;
+/// Levels of the submaps' score pyramids above the coarse grid (blocks of 32 coarse cells at the top).
+const PYRAMID_DEPTH: usize = 5;
+/// Times the drift rate a closure showed that the search window allows from then on.
+const DRIFT_MARGIN: f64 = 2.0;
+/// The drift rates the windows allow grow to at most this many times `window_per_metre` and
+/// `heading_window_per_metre`.
+const MAX_DRIFT_GROWTH: f64 = 4.0;
+
+/// The online pose graph: nodes, chain and loop edges, submaps, and what its searches did.
+#[derive(Debug, Clone)]
+pub struct LoopGraph {
+    params: LoopClosureParams,
+    matcher: ScanMatcher,
+    map: MapParams,
+    /// The nodes with their optimised poses (no parents: the graph holds the order).
+    nodes: Vec<TrajectoryNode>,
+    /// Where each node is drawn in the filter's maps (its pose when the filter was last re-anchored).
+    drawn: Vec<Xyt>,
+    /// Metres driven up to each node (along the graph's chain).
+    travel: Vec<f64>,
+    /// Edge k - 1 → k for every node k > 0.
+    chain: Vec<Edge>,
+    loops: Vec<Edge>,
+    submaps: Vec<Submap>,
+    /// First node of the submap being filled.
+    open_first: usize,
+    cache: GridCache,
+    /// Bumped by every optimisation that moved the nodes (cached submap grids are of one version).
+    version: u64,
+    /// Loop edges found since the last optimisation, and nodes added since.
+    pending: usize,
+    since_optimised: usize,
+    /// Metres driven at the last node that closed a loop.
+    last_closure: Option<f64>,
+    /// Drift per metre driven the search windows allow: translation (m/m) and heading (rad/m).
+    drift: (f64, f64),
+    /// The revisit being driven: travel at its start and whether a loop edge was found in it.
+    revisit: Option<(f64, bool)>,
+    report: LoopClosureReport,
+}
+
+impl LoopGraph {
+    /// An empty graph with loop settings `params`, matching with the filter's `matcher` for one scan alone on
+    /// grids and ranges of `map`, for a laser mounted at `laser`.
+    pub fn new(params: LoopClosureParams, matcher: &MatcherParams, map: MapParams, laser: Xyt) -> Self {
+        let p = MatcherParams { heading_search: 0.0, motion_prior: 0.0, ..matcher.alone() };
+        LoopGraph {
+            drift: (params.window_per_metre, params.heading_window_per_metre),
+            params,
+            matcher: ScanMatcher::new(p, laser, false),
+            map,
+            nodes: Vec::new(),
+            drawn: Vec::new(),
+            travel: Vec::new(),
+            chain: Vec::new(),
+            loops: Vec::new(),
+            submaps: Vec::new(),
+            open_first: 0,
+            cache: GridCache::default(),
+            version: 0,
+            pending: 0,
+            since_optimised: 0,
+            last_closure: None,
+            revisit: None,
+            report: LoopClosureReport::default(),
+        }
+    }
+
+    /// The nodes, oldest first, at their optimised poses.
+    pub fn nodes(&self) -> &[TrajectoryNode] {
+        &self.nodes
+    }
+
+    /// What the graph did so far.
+    pub fn report(&self) -> LoopClosureReport {
+        self.report
+    }
+
+    /// The loop edges kept, as (from, to) node indices.
+    pub fn loop_edges(&self) -> impl Iterator<Item = (usize, usize)> + '_ {
+        self.loops.iter().map(|e| (e.from, e.to))
+    }
+
+    /// The processed scan's prepared beams for loop matching.
+    fn prepare(&self, scan: &LaserScan) -> PreparedScan {
+        let range = self.map.max_urange.min(self.params.range);
+        PreparedScan::new(scan, self.map.max_range.min(scan.range_max as f64), range, 0)
+    }
+
+    /// Adds the node of a processed scan, `increment` from the node before (the filter's move between its
+    /// two nodes; the first node's pose is `increment` itself), searches it for loops and optimises when it is
+    /// time. Returns true when an optimisation moved a node's pose by more than a cell from where the filter
+    /// drew it: the filter should then be re-anchored ([`LoopGraph::mark_drawn`]).
+    pub fn add(&mut self, stamp: f64, increment: Xyt, scan: Arc<LaserScan>) -> bool {
+        let k = self.nodes.len();
+        let pose = match self.nodes.last() {
+            Some(last) => Xyt::from_pose(&(last.pose.to_pose() * increment.to_pose())),
+            None => increment,
+        };
+        let travel = self.nodes.last().map_or(0.0, |l| self.travel[k - 1] + (pose.x - l.pose.x).hypot(pose.y - l.pose.y));
+        if k > 0 {
+            self.chain.push(Edge { from: k - 1, to: k, measured: increment, information: self.chain_information(), huber: f64::INFINITY });
+        }
+        self.nodes.push(TrajectoryNode { stamp, pose, scan, parent: None });
+        self.drawn.push(pose);
+        self.travel.push(travel);
+        if k + 1 - self.open_first >= self.params.submap_scans.max(1) {
+            self.submaps.push(Submap { first: self.open_first, last: k });
+            self.open_first = k + 1;
+        }
+        self.search(k);
+        self.since_optimised += 1;
+        if self.pending > 0 && self.since_optimised >= self.params.optimize_every {
+            return self.optimise(ONLINE_ITERATIONS);
+        }
+        false
+    }
+
+    /// Ends the data: optimises once more when loop edges wait, and closes the revisit being driven.
+    pub fn finish(&mut self) -> bool {
+        let moved = self.pending > 0 && self.optimise(FINAL_ITERATIONS);
+        self.end_revisit();
+        moved
+    }
+
+    /// The filter was redrawn from the graph's poses: they are what its maps hold now.
+    pub fn mark_drawn(&mut self) {
+        for (d, n) in self.drawn.iter_mut().zip(&self.nodes) {
+            *d = n.pose;
+        }
+    }
+
+    /// Nodes whose pose differs from where the filter drew them: (node, drawn pose, pose now).
+    pub fn moved_since_drawn(&self) -> impl Iterator<Item = (&TrajectoryNode, Xyt)> + '_ {
+        self.nodes.iter().zip(&self.drawn).filter(|(n, d)| n.pose != **d).map(|(n, d)| (n, *d))
+    }
+
+    fn chain_information(&self) -> Information {
+        let (t, r) = (self.params.chain_sigma, self.params.chain_heading_sigma);
+        Information([1.0 / (t * t), 0.0, 0.0, 1.0 / (t * t), 0.0, 1.0 / (r * r)])
+    }
+
+    /// The search window for a node `driven` metres after the last closure (or after the submap).
+    fn window(&self, driven: f64) -> SearchWindow {
+        let p = &self.params;
+        SearchWindow {
+            linear: (p.window + self.drift.0 * driven).min(p.max_window),
+            angular: (p.heading_window + self.drift.1 * driven).min(p.max_heading_window),
+        }
+    }
+
+    /// Searches node `k` against the finished submaps it may be in; keeps the matches as loop edges.
+    fn search(&mut self, k: usize) {
+        let pose = self.nodes[k].pose;
+        let travel = self.travel[k];
+        let since_closure = self.last_closure.map_or(f64::INFINITY, |t| travel - t);
+        // Finished submaps passed a loop ago, with the distance from the node to their nearest node.
+        let mut near: Vec<(f64, usize, SearchWindow)> = Vec::new();
+        let mut revisit = false;
+        for (i, s) in self.submaps.iter().enumerate() {
+            let driven = travel - self.travel[s.last];
+            if driven < self.params.min_travel {
+                continue;
+            }
+            let d = (s.first..=s.last)
+                .map(|n| (self.nodes[n].pose.x - pose.x).hypot(self.nodes[n].pose.y - pose.y))
+                .fold(f64::INFINITY, f64::min);
+            revisit |= d <= self.params.search_radius;
+            let window = self.window(driven.min(since_closure));
+            if d <= self.params.search_radius + window.linear {
+                near.push((d, i, window));
+            }
+        }
+        near.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        near.truncate(self.params.max_searches);
+        let mut closed = false;
+        if !near.is_empty() {
+            let scan = self.prepare(&self.nodes[k].scan);
+            if scan.matched.len() >= 10 {
+                for &(_, i, window) in &near {
+                    self.report.candidates += 1;
+                    match self.match_submap(i, k, &scan, window) {
+                        Some(edge) => {
+                            self.accept(edge, travel);
+                            closed = true;
+                        }
+                        None => self.report.rejected += 1,
+                    }
+                }
+            }
+        }
+        match (revisit, &mut self.revisit) {
+            (true, Some((_, c))) => *c |= closed,
+            (true, None) => self.revisit = Some((travel, closed)),
+            (false, _) => self.end_revisit(),
+        }
+    }
+
+    /// A revisit ended: counted as left open when it was long and no loop edge was found in it.
+    fn end_revisit(&mut self) {
+        if let Some((start, closed)) = self.revisit.take() {
+            let length = self.travel.last().copied().unwrap_or(0.0) - start;
+            if !closed && length >= self.params.open_loop_travel {
+                self.report.open_loops += 1;
+            }
+        }
+    }
+
+    /// Node `k`'s match against submap `i` as a loop edge anchor → k, if any.
+    fn match_submap(&mut self, i: usize, k: usize, scan: &PreparedScan, window: SearchWindow) -> Option<Edge> {
+        let s = self.submaps[i];
+        let anchor = self.nodes[s.first].pose;
+        let grids = match self.cache.get(i, self.version) {
+            Some(g) => g,
+            None => {
+                let poses: Vec<Xyt> = (s.first..=s.last).map(|n| self.nodes[n].pose).collect();
+                let local = in_anchor_frame(&anchor, &poses);
+                let prepared: Vec<PreparedScan> = (s.first..=s.last).map(|n| self.prepare(&self.nodes[n].scan)).collect();
+                let scans: Vec<(Xyt, &PreparedScan)> = local.into_iter().zip(&prepared).collect();
+                let g = Arc::new(SubmapGrids::build(&scans, &self.matcher, self.map.delta, PYRAMID_DEPTH)?);
+                self.cache.put(i, self.version, g.clone());
+                g
+            }
+        };
+        let predicted = in_anchor_frame(&anchor, &[self.nodes[k].pose])[0];
+        let points = search_points(scan, &self.matcher, grids.cell);
+        let found = branch_and_bound_pose(&grids, &points, &predicted, window, 0.1);
+        if std::env::var("LOOP_DEBUG").is_ok() {
+            eprintln!("node {k} submap {i} window {window:?} found {found:?} predicted {predicted:?}");
+        }
+        let found = found.filter(|f| f.score >= self.params.min_score)?;
+        refine_to_edge(&grids, &self.matcher, scan, &found, &self.params, (s.first, k))
+    }
+
+    /// Keeps a loop edge and learns from it how far the robot drifted since the last closure.
+    fn accept(&mut self, edge: Edge, travel: f64) {
+        let predicted = in_anchor_frame(&self.nodes[edge.from].pose, &[self.nodes[edge.to].pose])[0];
+        let (dx, dy) = (edge.measured.x - predicted.x, edge.measured.y - predicted.y);
+        let dt = mrslam_core::pose::normalize_angle(edge.measured.theta - predicted.theta);
+        // The drift accumulated since the graph last knew where the robot was relative to the anchor.
+        let driven = travel - self.last_closure.unwrap_or(f64::NEG_INFINITY).max(self.travel[edge.from]);
+        if driven > self.params.min_travel {
+            let p = &self.params;
+            let rate = (DRIFT_MARGIN * dx.hypot(dy) / driven).min(MAX_DRIFT_GROWTH * p.window_per_metre);
+            let heading = (DRIFT_MARGIN * dt.abs() / driven).min(MAX_DRIFT_GROWTH * p.heading_window_per_metre);
+            self.drift = (self.drift.0.max(rate), self.drift.1.max(heading));
+        }
+        self.loops.push(edge);
+        self.pending += 1;
+        self.last_closure = Some(travel);
+        self.report.closures += 1;
+    }
+
+    /// Optimises the graph, drops the loop edges it cannot reconcile (worst first, re-optimising after each),
+    /// and says whether a node moved more than a cell from where the filter drew it.
+    fn optimise(&mut self, iterations: u32) -> bool {
+        self.pending = 0;
+        self.since_optimised = 0;
+        let mut poses: Vec<Xyt> = self.nodes.iter().map(|n| n.pose).collect();
+        loop {
+            let mut edges = self.chain.clone();
+            edges.extend_from_slice(&self.loops);
+            match optimize(&mut poses, &edges, iterations) {
+                Some(s) => self.report.iterations += s.iterations,
+                None => return false,
+            }
+            self.report.optimisations += 1;
+            let worst = self
+                .loops
+                .iter()
+                .enumerate()
+                .map(|(i, e)| (i, residual(e, &poses)))
+                .max_by(|a, b| a.1.total_cmp(&b.1));
+            match worst {
+                Some((i, r)) if r > self.params.max_residual => {
+                    self.loops.remove(i);
+                    self.report.closures -= 1;
+                    self.report.dropped += 1;
+                }
+                _ => break,
+            }
+        }
+        for (n, p) in self.nodes.iter_mut().zip(&poses) {
+            n.pose = *p;
+        }
+        self.recompute_travel();
+        self.version += 1;
+        let moved = self.drawn.iter().zip(&self.nodes).map(|(d, n)| (d.x - n.pose.x).hypot(d.y - n.pose.y)).fold(0.0, f64::max);
+        self.report.max_correction = self.report.max_correction.max(moved);
+        moved > 2.0 * self.map.delta
+    }
+
+    fn recompute_travel(&mut self) {
+        for k in 1..self.nodes.len() {
+            let (a, b) = (&self.nodes[k - 1].pose, &self.nodes[k].pose);
+            self.travel[k] = self.travel[k - 1] + (b.x - a.x).hypot(b.y - a.y);
+        }
+    }
+}
+
+/// An edge's Mahalanobis distance √(eᵀ Ω e) at `poses`.
+fn residual(e: &Edge, poses: &[Xyt]) -> f64 {
+    let z = e.measured.to_pose();
+    let err = Xyt::from_pose(&(z.inverse() * (poses[e.from].to_pose().inverse() * poses[e.to].to_pose())));
+    e.information.mahalanobis2(&[err.x, err.y, err.theta]).sqrt()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::loop_closure::tests::{error_to, office_nodes};
+    use mrslam_core::pose::relative;
+
+    /// Feeds the graph the office lap's true increments with a heading bias of `bias` rad per node; returns the
+    /// poses it holds after each node and its report.
+    fn drive(bias: f64, params: LoopClosureParams) -> (Vec<mrslam_core::Pose2>, Vec<Vec<Xyt>>, LoopClosureReport) {
+        let (truth, scans, laser) = office_nodes();
+        let p = crate::SlamParams::matched();
+        let map = MapParams { max_range: 30.0, max_urange: 30.0, ..p.map };
+        let mut graph = LoopGraph::new(params, &p.matcher, map, laser);
+        let mut history = Vec::new();
+        for k in 0..truth.len() {
+            let mut z = if k == 0 { Xyt::from_pose(&truth[0]) } else { Xyt::from_pose(&relative(&truth[k - 1], &truth[k])) };
+            if k > 0 {
+                z.theta += bias;
+            }
+            graph.add(k as f64, z, scans[k].clone());
+            history.push(graph.nodes().iter().map(|n| n.pose).collect());
+        }
+        graph.finish();
+        (truth, history, graph.report())
+    }
+
+    #[test]
+    fn a_lap_that_drifted_beyond_the_local_window_is_closed_while_driving() {
+        let params = crate::SlamParams::matched().loop_closure;
+        let (truth, history, report) = drive(0.004, params);
+        // Without loop closure: the increments alone.
+        let (_, open, _) = drive(0.004, LoopClosureParams { min_score: 1.0, ..params });
+        let (_, end_open) = error_to(&truth, open.last().unwrap());
+        assert!(end_open > 3.0 * params.window, "the lap must end beyond the local window: {end_open} m");
+        assert!(report.closures >= 3 && report.optimisations >= 1, "{report:?}");
+        let (worst, end) = error_to(&truth, history.last().unwrap());
+        assert!(end < 0.2, "the lap's end {end} m from the truth (was {end_open} m), {report:?}");
+        assert!(worst < 0.5 * end_open, "worst node {worst} m");
+        // Closed while driving: the poses the graph held a node after the first closure were already pulled in.
+        let first = (0..history.len()).find(|&k| error_to(&truth[..=k], &history[k]).1 < 0.2 && k > truth.len() / 2);
+        assert!(first.is_some_and(|k| k + 1 < truth.len()), "no node of the second pass was placed within 0.2 m");
+    }
+
+    #[test]
+    fn a_true_lap_stays_where_it_is() {
+        let params = crate::SlamParams::matched().loop_closure;
+        let (truth, history, report) = drive(0.0, params);
+        assert!(report.closures >= 3, "{report:?}");
+        assert_eq!(report.dropped, 0, "{report:?}");
+        let (worst, _) = error_to(&truth, history.last().unwrap());
+        assert!(worst < 0.03, "the graph moved a true pose {worst} m");
+    }
+}
