@@ -237,7 +237,8 @@ pub fn run(args: SlamArgs) -> Result<ExitCode> {
             if filter.counters().reanchors > reanchors {
                 reanchors = filter.counters().reanchors;
                 let path: Vec<Pose2> = filter.trajectory().into_iter().map(|(_, p)| p).collect();
-                let edges: Vec<(Pose2, Pose2)> = filter.loop_edges().into_iter().map(|(a, b)| (path[a], path[b])).collect();
+                let edges: Vec<(Pose2, Pose2)> =
+                    filter.loop_edges().into_iter().map(|(a, b)| (path[a], path[b])).collect();
                 let l = filter.loop_report().unwrap_or_default();
                 let text = format!(
                     "loop closed: {} loop edges kept; the trajectory moved by up to {:.2} m",
@@ -451,7 +452,8 @@ fn record_the_end(
     v.set_time(last as u64, scans[last].scan.stamp - stamp0);
     if let Some(l) = &run.loop_closure {
         let level = if l.closures > 0 && l.open_loops == 0 { Level::Info } else { Level::Warn };
-        let text = format!("loop closure: {}", describe_loops(l, filter.params().loop_closure.online, run.processed.len()));
+        let text =
+            format!("loop closure: {}", describe_loops(l, filter.params().loop_closure.online, run.processed.len()));
         v.event(level, &text);
     }
     let smoothed: Vec<Pose2> = filter.trajectory().into_iter().map(|(_, p)| p).collect();

@@ -394,8 +394,11 @@ fn a_recorded_run_holds_the_filter_as_it_went_and_the_relations_errors() {
     assert_eq!(rows("/metrics/relations/office/translation"), 230);
     assert_eq!(rows("/metrics/relations/office/rotation"), 230);
     assert_eq!(rows("/robots/office/relations"), 1);
-    // Events: each resampling, and the loop closure's verdict (the matched preset closes loops).
-    assert_eq!(rows("/events"), resamples + 1, "{:?}", r.rows);
+    // Events: each resampling, each re-anchoring on the loop-closed graph (drawn with the loop edges and the
+    // corrected path), and the loop closure's verdict (the matched preset closes loops while it drives).
+    let reanchors = s["loop_closure"]["reanchors"].as_u64().unwrap() as usize;
+    assert_eq!(rows("/events"), resamples + reanchors + 1, "{:?}", r.rows);
+    assert_eq!(rows("/robots/office/slam/loop_edges"), reanchors, "{:?}", r.rows);
     assert!(r.blueprint_entities.contains("/viewport"), "{:?}", r.blueprint_entities);
 
     // A destination that cannot be written fails before the filter runs, and leaves no map.

@@ -10,9 +10,12 @@
 //! Data flow per [`Rbpf::process`] call: odometry increment → `motion` sampling for every particle →
 //! (when the robot moved enough) `scan_matcher` refinement and likelihood → `resample` → the scan's hits
 //! go into each particle's copy-on-write `tile_map` → a new `particle` trajectory node.
-//! The output map ([`Rbpf::map`]) is rebuilt by `map_build` from the best particle's trajectory; with
-//! `loop_closure` on, [`map_log`] first smooths that trajectory ([`Rbpf::close_loops`]: `loop_closure` finds
-//! loop edges, `mrslam_matching::pose_graph` optimises).
+//! The output map ([`Rbpf::map`]) is rebuilt by `map_build` from the best particle's trajectory. With
+//! `loop_closure` on (the `matched` preset), `loop_graph` keeps a pose graph beside the filter: each processed
+//! scan is a node, searched by branch and bound against the submaps passed a loop ago, the graph optimised
+//! (`mrslam_matching::pose_graph`) as loops are found and the particles re-anchored on it; the trajectory and
+//! the map are then the graph's. With `loop_closure.online` off, [`map_log`] smooths the trajectory at the end
+//! instead ([`Rbpf::close_loops`]: `loop_closure` finds loop edges by local searches).
 //!
 //! [`SlamBackend`] is what code that feeds a SLAM needs of it (process a reading, the map, the best pose, the
 //! trajectory, loop-closure corrections, the pose hypotheses for display); [`Rbpf`] implements it, and

@@ -30,10 +30,10 @@ use serde::{Deserialize, Serialize};
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct LoopClosureParams {
-    /// `loop_closure`: when the log ends, smooth the best particle's trajectory with a pose graph whose loop
-    /// edges match each processed scan against the scans around the place it passed a loop ago (see
-    /// `loop_closure`), and map from the smoothed poses. Off (the default): the filter's trajectory, as
-    /// GMapping.
+    /// `loop_closure`: close loops with a pose graph over the processed scans: while the robot drives (`online`,
+    /// see `loop_graph`), or when the log ends (smoothing the best particle's trajectory with loop edges that
+    /// match each processed scan against the scans around the place it passed a loop ago, see `loop_closure`);
+    /// the map is drawn from the graph's poses. Off (the default): the filter's trajectory, as GMapping.
     pub enabled: bool,
     /// `loop_min_travel`, metres driven: a place is a loop ago when the robot drove at least this far since it
     /// passed there.
@@ -85,6 +85,9 @@ pub struct LoopClosureParams {
     /// `loop_min_score`: the branch and bound keeps a pose whose scan points score at least this on average (1 on
     /// a wall of the submap, falling as a Gaussian of the distance, σ 2 cells).
     pub min_score: f64,
+    /// `loop_max_rival`: a branch and bound answer is refused when another pose at least a metre from it scores
+    /// this fraction of its score or more (along a featureless corridor every offset scores alike).
+    pub max_rival: f64,
     /// `loop_max_searches`: submaps a processed scan is searched against at most (the nearest).
     pub max_searches: usize,
     /// `loop_optimize_every`: processed scans between optimisations while loop edges wait.
@@ -118,7 +121,8 @@ impl Default for LoopClosureParams {
             heading_window_per_metre: 0.003,
             max_window: 10.0,
             max_heading_window: 0.8,
-            min_score: 0.55,
+            min_score: 0.6,
+            max_rival: 0.8,
             max_searches: 3,
             optimize_every: 10,
             max_residual: 10.0,
@@ -330,39 +334,10 @@ pub(crate) fn loop_information(h: &Information, theta: f64, params: &LoopClosure
 }
 
 #[cfg(test)]
-pub(crate) mod tests {
+mod tests {
     use super::*;
-    use crate::synthetic::{self, Drift, Lidar};
-    use mrslam_core::{Pose2, pose};
+    use crate::synthetic::{error_to, office_keyframes as office_nodes};
     use std::sync::Arc;
-
-    /// The office loop seen by a SICK-class lidar from the true poses, a node every metre or quarter turn.
-    pub(crate) fn office_nodes() -> (Vec<Pose2>, Vec<Arc<mrslam_core::LaserScan>>, Xyt) {
-        let path = synthetic::waypoint_path(&synthetic::office_loop(), 0.05, 0.1);
-        let run = synthetic::simulate(
-            &synthetic::office_map(),
-            &path,
-            0.1,
-            &Lidar::sick(),
-            pose(0.1, 0.0, 0.0),
-            &Drift::none(),
-            3,
-        );
-        let (mut truth, mut scans) = (Vec::new(), Vec::new());
-        let mut last: Option<Pose2> = None;
-        for ((_, p), s) in run.truth.iter().zip(&run.scans) {
-            let due = last.is_none_or(|l| {
-                let d = Xyt::from_pose(&relative(&l, p));
-                d.x.hypot(d.y) >= 1.0 || d.theta.abs() >= 0.25
-            });
-            if due {
-                truth.push(*p);
-                scans.push(Arc::new(s.clone()));
-                last = Some(*p);
-            }
-        }
-        (truth, scans, Xyt::from_pose(&run.laser_offset))
-    }
 
     fn nodes(poses: &[Xyt], scans: &[Arc<mrslam_core::LaserScan>]) -> Vec<TrajectoryNode> {
         poses
@@ -371,13 +346,6 @@ pub(crate) mod tests {
             .enumerate()
             .map(|(k, (p, s))| TrajectoryNode { stamp: k as f64, pose: *p, scan: s.clone(), parent: None })
             .collect()
-    }
-
-    /// The largest and the last distance between `truth` and `poses`.
-    pub(crate) fn error_to(truth: &[Pose2], poses: &[Xyt]) -> (f64, f64) {
-        let e: Vec<f64> =
-            truth.iter().zip(poses).map(|(t, p)| (t.translation.x - p.x).hypot(t.translation.y - p.y)).collect();
-        (e.iter().copied().fold(0.0, f64::max), e[e.len() - 1])
     }
 
     #[test]

@@ -396,10 +396,24 @@ impl Rbpf {
             Some(parent) => Xyt::from_pose(&relative(&parent.pose.to_pose(), &node.pose.to_pose())),
             None => node.pose,
         };
-        if graph.add(stamp, increment, scan.clone()) {
+        let redraw = graph.add(stamp, increment, scan.clone());
+        self.take_graph_corrections();
+        if redraw {
             self.reanchor()?;
         }
         Ok(())
+    }
+
+    /// Moves the online graph's optimisations made since the last call into [`Rbpf::corrections`].
+    fn take_graph_corrections(&mut self) {
+        if let Some(g) = self.graph.as_mut() {
+            let moved = g.take_moved().into_iter();
+            self.corrections.extend(moved.map(|(stamp, before, after)| Correction {
+                stamp,
+                before: before.to_pose(),
+                after: after.to_pose(),
+            }));
+        }
     }
 
     /// Redraws the particles' maps from the graph's poses (one map, shared) and moves every particle by the
@@ -421,9 +435,6 @@ impl Rbpf {
             let banded = banded_beams(&prepared, band, p.map.delta);
             draw_scan(&mut map, &self.matcher.laser_pose(&n.pose), &prepared.hits, &banded, band)
                 .map_err(|_| SlamError::MapTooLarge("the loop-closed map left the largest map supported".into()))?;
-        }
-        for (n, before) in graph.moved_since_drawn() {
-            self.corrections.push(Correction { stamp: n.stamp, before: before.to_pose(), after: n.pose.to_pose() });
         }
         graph.mark_drawn();
         let newest = Arc::new(TrajectoryNode { stamp, pose, scan, parent: None });
@@ -535,13 +546,21 @@ impl Rbpf {
         v
     }
 
-    /// Smooths the best particle's trajectory by loop closure (see [`SlamParams::loop_closure`]; runs whether
-    /// or not that is set) and returns what it did: the trajectory, [`Rbpf::map`] and [`Rbpf::best_pose`] are
+    /// Ends loop closure: with the online graph (`loop_closure.online`), its last optimisation; otherwise smooths
+    /// the best particle's trajectory by loop closure (see [`SlamParams::loop_closure`]; runs whether or not that
+    /// is set). Returns what loop closure did: the trajectory, [`Rbpf::map`] and [`Rbpf::best_pose`] are
     /// the smoothed ones afterwards.
     ///
     /// Meant for the end of a log: the particles' matching maps are not rebuilt, so a filter that goes on
     /// after it matches against maps that do not fit the smoothed trajectory.
     pub fn close_loops(&mut self) -> LoopClosureReport {
+        if let Some(g) = self.graph.as_mut() {
+            // The last optimisation; the particles are not redrawn (no reading follows).
+            g.finish();
+            let report = g.report();
+            self.take_graph_corrections();
+            return report;
+        }
         let best = self.best_index();
         let part = &self.particles[best];
         let mut nodes: Vec<&TrajectoryNode> = ancestry(&part.node).collect();
@@ -645,16 +664,6 @@ impl SlamBackend for Rbpf {
     }
 
     fn finish(&mut self) -> Option<LoopClosureReport> {
-        if let Some(g) = self.graph.as_mut() {
-            if g.finish() {
-                // The last optimisation's corrections; the particles are not redrawn (no reading follows).
-                for (n, before) in g.moved_since_drawn() {
-                    self.corrections.push(Correction { stamp: n.stamp, before: before.to_pose(), after: n.pose.to_pose() });
-                }
-                g.mark_drawn();
-            }
-            return Some(g.report());
-        }
         self.params.loop_closure.enabled.then(|| self.close_loops())
     }
 

@@ -339,6 +339,66 @@ pub fn office_loop() -> Vec<(f64, f64)> {
     vec![(2.0, 2.0), (22.0, 2.0), (22.0, 12.0), (2.0, 12.0), (2.0, 2.0), (10.0, 2.0)]
 }
 
+/// A building `w × h` metres whose corridor, `corridor` metres wide, runs round a solid core: a loop of about
+/// 2(w + h) - 4·corridor metres. Boxes (cabinets, pillars) and niches are placed along both walls at irregular
+/// spacings drawn from `seed`, so that no stretch looks like another, but many look alike at a glance.
+pub fn ring_building(w: f64, h: f64, corridor: f64, seed: u64) -> OccupancyGrid {
+    let t = 0.15;
+    let mut g = walled(w, h, t);
+    let inner = t + corridor;
+    fill(&mut g, inner, inner, w - inner, h - inner, WALL);
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    // Walk each wall of the ring (outer and inner face of each side) and place a feature every 2-6 m.
+    let sides: [(f64, f64, f64, f64, bool); 4] = [
+        (t, t, w - t, inner, true),          // bottom corridor: x varies
+        (t, h - inner, w - t, h - t, true),  // top
+        (t, t, inner, h - t, false),         // left: y varies
+        (w - inner, t, w - t, h - t, false), // right
+    ];
+    for (x0, y0, x1, y1, along_x) in sides {
+        let (from, to) = if along_x { (x0 + inner, x1 - inner) } else { (y0 + inner, y1 - inner) };
+        let mut u = from + rng.random_range(1.0..3.0);
+        while u < to - 1.0 {
+            let len = rng.random_range(0.3..1.4);
+            let depth = rng.random_range(0.2..0.6_f64).min(0.25 * corridor);
+            let outer_face = rng.random_bool(0.5);
+            let niche = rng.random_bool(0.3);
+            let (a, b) = (u, (u + len).min(to));
+            let rect = match (along_x, outer_face) {
+                (true, true) if y0 <= t => (a, y0, b, y0 + depth),
+                (true, false) if y0 <= t => (a, y1 - depth, b, y1),
+                (true, true) => (a, y1 - depth, b, y1),
+                (true, false) => (a, y0, b, y0 + depth),
+                (false, true) if x0 <= t => (x0, a, x0 + depth, b),
+                (false, false) if x0 <= t => (x1 - depth, a, x1, b),
+                (false, true) => (x1 - depth, a, x1, b),
+                (false, false) => (x0, a, x0 + depth, b),
+            };
+            if niche {
+                // cut into the wall behind the face instead
+                let (rx0, ry0, rx1, ry1) = rect;
+                let (dx, dy) = if along_x {
+                    (0.0, if ry0 <= y0 { -depth } else { depth })
+                } else {
+                    (if rx0 <= x0 { -depth } else { depth }, 0.0)
+                };
+                fill(&mut g, rx0 + dx, ry0 + dy, rx1 + dx, ry1 + dy, FREE);
+            } else {
+                fill(&mut g, rect.0, rect.1, rect.2, rect.3, WALL);
+            }
+            u = b + rng.random_range(2.0..6.0);
+        }
+    }
+    g
+}
+
+/// The centre line of [`ring_building`]'s corridor once round, from the bottom-left corner anticlockwise, then
+/// `beyond` metres along the bottom corridor again.
+pub fn ring_loop(w: f64, h: f64, corridor: f64, beyond: f64) -> Vec<(f64, f64)> {
+    let c = 0.15 + 0.5 * corridor;
+    vec![(c, c), (w - c, c), (w - c, h - c), (c, h - c), (c, c), (c + beyond, c)]
+}
+
 /// A corridor `length` metres long and 5 m wide, with protrusions (a table, a water cooler, a fence, a
 /// staircase: boxes along the walls) every few metres, as in the paper's first experiment.
 pub fn corridor_map(length: f64) -> OccupancyGrid {
@@ -358,6 +418,34 @@ pub fn corridor_map(length: f64) -> OccupancyGrid {
         k += 1;
     }
     g
+}
+
+/// The office loop seen by a SICK-class lidar from the true poses, one keyframe every metre or quarter turn: the
+/// true poses, their scans and the laser mount (test data for loop closure).
+pub fn office_keyframes() -> (Vec<Pose2>, Vec<std::sync::Arc<LaserScan>>, Xyt) {
+    let path = waypoint_path(&office_loop(), 0.05, 0.1);
+    let run = simulate(&office_map(), &path, 0.1, &Lidar::sick(), pose(0.1, 0.0, 0.0), &Drift::none(), 3);
+    let (mut truth, mut scans) = (Vec::new(), Vec::new());
+    let mut last: Option<Pose2> = None;
+    for ((_, p), s) in run.truth.iter().zip(&run.scans) {
+        let due = last.is_none_or(|l| {
+            let d = Xyt::from_pose(&relative(&l, p));
+            d.x.hypot(d.y) >= 1.0 || d.theta.abs() >= 0.25
+        });
+        if due {
+            truth.push(*p);
+            scans.push(std::sync::Arc::new(s.clone()));
+            last = Some(*p);
+        }
+    }
+    (truth, scans, Xyt::from_pose(&run.laser_offset))
+}
+
+/// The largest and the last distance between `truth` and `poses` (paired in order).
+pub fn error_to(truth: &[Pose2], poses: &[Xyt]) -> (f64, f64) {
+    let e: Vec<f64> =
+        truth.iter().zip(poses).map(|(t, p)| (t.translation.x - p.x).hypot(t.translation.y - p.y)).collect();
+    (e.iter().copied().fold(0.0, f64::max), e.last().copied().unwrap_or(0.0))
 }
 
 #[cfg(test)]

@@ -51,6 +51,8 @@ pub struct LoopGraph {
     nodes: Vec<TrajectoryNode>,
     /// Where each node is drawn in the filter's maps (its pose when the filter was last re-anchored).
     drawn: Vec<Xyt>,
+    /// Each node's pose as last reported ([`LoopGraph::take_moved`]).
+    reported: Vec<Xyt>,
     /// Metres driven up to each node (along the graph's chain).
     travel: Vec<f64>,
     /// Edge k - 1 → k for every node k > 0.
@@ -65,8 +67,9 @@ pub struct LoopGraph {
     /// Loop edges found since the last optimisation, and nodes added since.
     pending: usize,
     since_optimised: usize,
-    /// Metres driven at the last node that closed a loop.
-    last_closure: Option<f64>,
+    /// Metres from the newest node to each node through the graph: along the chain, loop edges counting 0. How
+    /// far the graph's pose of a node can have drifted from the newest one's grows with it.
+    reach: Vec<f64>,
     /// Drift per metre driven the search windows allow: translation (m/m) and heading (rad/m).
     drift: (f64, f64),
     /// The revisit being driven: travel at its start and whether a loop edge was found in it.
@@ -86,6 +89,7 @@ impl LoopGraph {
             map,
             nodes: Vec::new(),
             drawn: Vec::new(),
+            reported: Vec::new(),
             travel: Vec::new(),
             chain: Vec::new(),
             loops: Vec::new(),
@@ -95,7 +99,7 @@ impl LoopGraph {
             version: 0,
             pending: 0,
             since_optimised: 0,
-            last_closure: None,
+            reach: Vec::new(),
             revisit: None,
             report: LoopClosureReport::default(),
         }
@@ -132,12 +136,25 @@ impl LoopGraph {
             Some(last) => Xyt::from_pose(&(last.pose.to_pose() * increment.to_pose())),
             None => increment,
         };
-        let travel = self.nodes.last().map_or(0.0, |l| self.travel[k - 1] + (pose.x - l.pose.x).hypot(pose.y - l.pose.y));
+        let travel =
+            self.nodes.last().map_or(0.0, |l| self.travel[k - 1] + (pose.x - l.pose.x).hypot(pose.y - l.pose.y));
         if k > 0 {
-            self.chain.push(Edge { from: k - 1, to: k, measured: increment, information: self.chain_information(), huber: f64::INFINITY });
+            self.chain.push(Edge {
+                from: k - 1,
+                to: k,
+                measured: increment,
+                information: self.chain_information(),
+                huber: f64::INFINITY,
+            });
         }
+        let step = travel - self.travel.last().copied().unwrap_or(0.0);
+        for r in &mut self.reach {
+            *r += step;
+        }
+        self.reach.push(0.0);
         self.nodes.push(TrajectoryNode { stamp, pose, scan, parent: None });
         self.drawn.push(pose);
+        self.reported.push(pose);
         self.travel.push(travel);
         if k + 1 - self.open_first >= self.params.submap_scans.max(1) {
             self.submaps.push(Submap { first: self.open_first, last: k });
@@ -145,10 +162,11 @@ impl LoopGraph {
         }
         self.search(k);
         self.since_optimised += 1;
-        if self.pending > 0 && self.since_optimised >= self.params.optimize_every {
-            return self.optimise(ONLINE_ITERATIONS);
-        }
-        false
+        let redraw =
+            self.pending > 0 && self.since_optimised >= self.params.optimize_every && self.optimise(ONLINE_ITERATIONS);
+        // Nobody has seen the new node's pose before the optimisation: it is not reported as moved.
+        self.reported[k] = self.nodes[k].pose;
+        redraw
     }
 
     /// Ends the data: optimises once more when loop edges wait, and closes the revisit being driven.
@@ -165,9 +183,16 @@ impl LoopGraph {
         }
     }
 
-    /// Nodes whose pose differs from where the filter drew them: (node, drawn pose, pose now).
-    pub fn moved_since_drawn(&self) -> impl Iterator<Item = (&TrajectoryNode, Xyt)> + '_ {
-        self.nodes.iter().zip(&self.drawn).filter(|(n, d)| n.pose != **d).map(|(n, d)| (n, *d))
+    /// Nodes an optimisation moved since the last call: (stamp, pose before, pose now), oldest first.
+    pub fn take_moved(&mut self) -> Vec<(f64, Xyt, Xyt)> {
+        let mut moved = Vec::new();
+        for (r, n) in self.reported.iter_mut().zip(&self.nodes) {
+            if *r != n.pose {
+                moved.push((n.stamp, *r, n.pose));
+                *r = n.pose;
+            }
+        }
+        moved
     }
 
     fn chain_information(&self) -> Information {
@@ -175,7 +200,7 @@ impl LoopGraph {
         Information([1.0 / (t * t), 0.0, 0.0, 1.0 / (t * t), 0.0, 1.0 / (r * r)])
     }
 
-    /// The search window for a node `driven` metres after the last closure (or after the submap).
+    /// The search window for a place `driven` metres from the newest node through the graph.
     fn window(&self, driven: f64) -> SearchWindow {
         let p = &self.params;
         SearchWindow {
@@ -188,7 +213,6 @@ impl LoopGraph {
     fn search(&mut self, k: usize) {
         let pose = self.nodes[k].pose;
         let travel = self.travel[k];
-        let since_closure = self.last_closure.map_or(f64::INFINITY, |t| travel - t);
         // Finished submaps passed a loop ago, with the distance from the node to their nearest node.
         let mut near: Vec<(f64, usize, SearchWindow)> = Vec::new();
         let mut revisit = false;
@@ -201,7 +225,8 @@ impl LoopGraph {
                 .map(|n| (self.nodes[n].pose.x - pose.x).hypot(self.nodes[n].pose.y - pose.y))
                 .fold(f64::INFINITY, f64::min);
             revisit |= d <= self.params.search_radius;
-            let window = self.window(driven.min(since_closure));
+            let through_graph = (s.first..=s.last).map(|n| self.reach[n]).fold(f64::INFINITY, f64::min);
+            let window = self.window(through_graph);
             if d <= self.params.search_radius + window.linear {
                 near.push((d, i, window));
             }
@@ -216,13 +241,16 @@ impl LoopGraph {
                     self.report.candidates += 1;
                     match self.match_submap(i, k, &scan, window) {
                         Some(edge) => {
-                            self.accept(edge, travel);
+                            self.accept(edge);
                             closed = true;
                         }
                         None => self.report.rejected += 1,
                     }
                 }
             }
+        }
+        if closed {
+            self.update_reach(k);
         }
         match (revisit, &mut self.revisit) {
             (true, Some((_, c))) => *c |= closed,
@@ -250,7 +278,8 @@ impl LoopGraph {
             None => {
                 let poses: Vec<Xyt> = (s.first..=s.last).map(|n| self.nodes[n].pose).collect();
                 let local = in_anchor_frame(&anchor, &poses);
-                let prepared: Vec<PreparedScan> = (s.first..=s.last).map(|n| self.prepare(&self.nodes[n].scan)).collect();
+                let prepared: Vec<PreparedScan> =
+                    (s.first..=s.last).map(|n| self.prepare(&self.nodes[n].scan)).collect();
                 let scans: Vec<(Xyt, &PreparedScan)> = local.into_iter().zip(&prepared).collect();
                 let g = Arc::new(SubmapGrids::build(&scans, &self.matcher, self.map.delta, PYRAMID_DEPTH)?);
                 self.cache.put(i, self.version, g.clone());
@@ -259,21 +288,18 @@ impl LoopGraph {
         };
         let predicted = in_anchor_frame(&anchor, &[self.nodes[k].pose])[0];
         let points = search_points(scan, &self.matcher, grids.cell);
-        let found = branch_and_bound_pose(&grids, &points, &predicted, window, 0.1);
-        if std::env::var("LOOP_DEBUG").is_ok() {
-            eprintln!("node {k} submap {i} window {window:?} found {found:?} predicted {predicted:?}");
-        }
-        let found = found.filter(|f| f.score >= self.params.min_score)?;
+        let found = branch_and_bound_pose(&grids, &points, &predicted, window, self.params.min_score)
+            .filter(|f| f.rival < self.params.max_rival)?;
         refine_to_edge(&grids, &self.matcher, scan, &found, &self.params, (s.first, k))
     }
 
     /// Keeps a loop edge and learns from it how far the robot drifted since the last closure.
-    fn accept(&mut self, edge: Edge, travel: f64) {
+    fn accept(&mut self, edge: Edge) {
         let predicted = in_anchor_frame(&self.nodes[edge.from].pose, &[self.nodes[edge.to].pose])[0];
         let (dx, dy) = (edge.measured.x - predicted.x, edge.measured.y - predicted.y);
         let dt = mrslam_core::pose::normalize_angle(edge.measured.theta - predicted.theta);
         // The drift accumulated since the graph last knew where the robot was relative to the anchor.
-        let driven = travel - self.last_closure.unwrap_or(f64::NEG_INFINITY).max(self.travel[edge.from]);
+        let driven = self.reach[edge.from];
         if driven > self.params.min_travel {
             let p = &self.params;
             let rate = (DRIFT_MARGIN * dx.hypot(dy) / driven).min(MAX_DRIFT_GROWTH * p.window_per_metre);
@@ -282,8 +308,35 @@ impl LoopGraph {
         }
         self.loops.push(edge);
         self.pending += 1;
-        self.last_closure = Some(travel);
         self.report.closures += 1;
+    }
+
+    /// Recomputes [`LoopGraph::reach`] from node `k` (Dijkstra over the chain and the loop edges).
+    fn update_reach(&mut self, k: usize) {
+        let n = self.nodes.len();
+        let mut loops: Vec<Vec<usize>> = vec![Vec::new(); n];
+        for e in &self.loops {
+            loops[e.from].push(e.to);
+            loops[e.to].push(e.from);
+        }
+        let mut reach = vec![f64::INFINITY; n];
+        let mut heap = std::collections::BinaryHeap::new();
+        reach[k] = 0.0;
+        heap.push((std::cmp::Reverse(Metres(0.0)), k));
+        while let Some((std::cmp::Reverse(Metres(d)), v)) = heap.pop() {
+            if d > reach[v] {
+                continue;
+            }
+            let chain = [v.checked_sub(1), (v + 1 < n).then_some(v + 1)];
+            let steps = chain.into_iter().flatten().map(|u| (u, (self.travel[u] - self.travel[v]).abs()));
+            for (u, w) in steps.chain(loops[v].iter().map(|&u| (u, 0.0))) {
+                if d + w < reach[u] {
+                    reach[u] = d + w;
+                    heap.push((std::cmp::Reverse(Metres(d + w)), u));
+                }
+            }
+        }
+        self.reach = reach;
     }
 
     /// Optimises the graph, drops the loop edges it cannot reconcile (worst first, re-optimising after each),
@@ -300,12 +353,8 @@ impl LoopGraph {
                 None => return false,
             }
             self.report.optimisations += 1;
-            let worst = self
-                .loops
-                .iter()
-                .enumerate()
-                .map(|(i, e)| (i, residual(e, &poses)))
-                .max_by(|a, b| a.1.total_cmp(&b.1));
+            let worst =
+                self.loops.iter().enumerate().map(|(i, e)| (i, residual(e, &poses))).max_by(|a, b| a.1.total_cmp(&b.1));
             match worst {
                 Some((i, r)) if r > self.params.max_residual => {
                     self.loops.remove(i);
@@ -320,7 +369,8 @@ impl LoopGraph {
         }
         self.recompute_travel();
         self.version += 1;
-        let moved = self.drawn.iter().zip(&self.nodes).map(|(d, n)| (d.x - n.pose.x).hypot(d.y - n.pose.y)).fold(0.0, f64::max);
+        let moved =
+            self.drawn.iter().zip(&self.nodes).map(|(d, n)| (d.x - n.pose.x).hypot(d.y - n.pose.y)).fold(0.0, f64::max);
         self.report.max_correction = self.report.max_correction.max(moved);
         moved > 2.0 * self.map.delta
     }
@@ -330,6 +380,21 @@ impl LoopGraph {
             let (a, b) = (&self.nodes[k - 1].pose, &self.nodes[k].pose);
             self.travel[k] = self.travel[k - 1] + (b.x - a.x).hypot(b.y - a.y);
         }
+    }
+}
+
+/// A distance ordered for the heap (never NaN).
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Metres(f64);
+impl Eq for Metres {}
+impl PartialOrd for Metres {
+    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(other))
+    }
+}
+impl Ord for Metres {
+    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
+        self.0.total_cmp(&other.0)
     }
 }
 
@@ -343,7 +408,7 @@ fn residual(e: &Edge, poses: &[Xyt]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::loop_closure::tests::{error_to, office_nodes};
+    use crate::synthetic::{error_to, office_keyframes as office_nodes};
     use mrslam_core::pose::relative;
 
     /// Feeds the graph the office lap's true increments with a heading bias of `bias` rad per node; returns the
@@ -355,7 +420,8 @@ mod tests {
         let mut graph = LoopGraph::new(params, &p.matcher, map, laser);
         let mut history = Vec::new();
         for k in 0..truth.len() {
-            let mut z = if k == 0 { Xyt::from_pose(&truth[0]) } else { Xyt::from_pose(&relative(&truth[k - 1], &truth[k])) };
+            let mut z =
+                if k == 0 { Xyt::from_pose(&truth[0]) } else { Xyt::from_pose(&relative(&truth[k - 1], &truth[k])) };
             if k > 0 {
                 z.theta += bias;
             }
@@ -369,9 +435,9 @@ mod tests {
     #[test]
     fn a_lap_that_drifted_beyond_the_local_window_is_closed_while_driving() {
         let params = crate::SlamParams::matched().loop_closure;
-        let (truth, history, report) = drive(0.004, params);
+        let (truth, history, report) = drive(0.0035, params);
         // Without loop closure: the increments alone.
-        let (_, open, _) = drive(0.004, LoopClosureParams { min_score: 1.0, ..params });
+        let (_, open, _) = drive(0.0035, LoopClosureParams { min_score: 1.0, ..params });
         let (_, end_open) = error_to(&truth, open.last().unwrap());
         assert!(end_open > 3.0 * params.window, "the lap must end beyond the local window: {end_open} m");
         assert!(report.closures >= 3 && report.optimisations >= 1, "{report:?}");

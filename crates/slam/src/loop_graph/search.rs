@@ -32,7 +32,13 @@ pub struct Found {
     pub pose: Xyt,
     /// Mean score of the scan's points, in (0, 1].
     pub score: f64,
+    /// The best score of a pose at least [`AMBIGUITY_SEPARATION`] from this one (any heading), relative to this
+    /// one's; 0 when none reached the minimum score. Near 1 along a featureless corridor: the match is ambiguous.
+    pub rival: f64,
 }
+
+/// Metres apart two answers of the branch and bound must be to be rivals.
+pub const AMBIGUITY_SEPARATION: f64 = 1.0;
 
 /// The scan's end points (robot frame) the branch and bound places: one per coarse cell, at most
 /// [`MAX_POINTS`] (an even stride).
@@ -79,26 +85,34 @@ pub fn branch_and_bound_pose(
         y1: cy.floor() as i32 + half,
     };
     let floor = (min_score * HIT as f64 * points.len() as f64).ceil() as i64;
+    let separation = (AMBIGUITY_SEPARATION / cell).ceil() as i32;
     let headings: Vec<i32> = (-(steps as i32)..=steps as i32).collect();
-    let best = headings
-        .par_iter()
-        .map_init(
-            || (Vec::new(), Vec::new()),
-            |(cells, scratch), &k| {
-                let theta = predicted.theta + k as f64 * step;
-                let (s, c) = theta.sin_cos();
-                cells.clear();
-                cells.extend(points.iter().map(|&(x, y)| {
-                    (((c * x - s * y) / cell).floor() as i32, ((s * x + c * y) / cell).floor() as i32)
-                }));
-                let mut best = Best::new(1, 1, floor);
-                branch_and_bound(&grids.pyramid, cells, win, &mut best, scratch);
-                best.found.first().map(|f| (f.score, -(k.abs()), k, f.ox, f.oy))
-            },
-        )
-        .flatten()
-        .max_by(|a, b| a.0.cmp(&b.0).then(a.1.cmp(&b.1)).then(b.2.cmp(&a.2)))?;
-    let (score, _, k, ox, oy) = best;
+    // The two best distinct offsets of every heading, best first overall.
+    let mut found: Vec<(i64, i32, i32, i32)> =
+        headings
+            .par_iter()
+            .map_init(
+                || (Vec::new(), Vec::new()),
+                |(cells, scratch), &k| {
+                    let theta = predicted.theta + k as f64 * step;
+                    let (s, c) = theta.sin_cos();
+                    cells.clear();
+                    cells.extend(points.iter().map(|&(x, y)| {
+                        (((c * x - s * y) / cell).floor() as i32, ((s * x + c * y) / cell).floor() as i32)
+                    }));
+                    let mut best = Best::new(2, separation, floor);
+                    branch_and_bound(&grids.pyramid, cells, win, &mut best, scratch);
+                    best.found.iter().map(|f| (f.score, k, f.ox, f.oy)).collect::<Vec<_>>()
+                },
+            )
+            .flatten()
+            .collect();
+    found.sort_by(|a, b| b.0.cmp(&a.0).then(a.1.abs().cmp(&b.1.abs())).then(a.1.cmp(&b.1)));
+    let &(score, k, ox, oy) = found.first()?;
+    let rival = found
+        .iter()
+        .find(|r| (r.2 - ox).abs() >= separation || (r.3 - oy).abs() >= separation)
+        .map_or(0.0, |r| r.0 as f64 / score as f64);
     Some(Found {
         pose: Xyt {
             x: grids.origin.0 + (ox as f64 + 0.5) * cell,
@@ -106,6 +120,7 @@ pub fn branch_and_bound_pose(
             theta: predicted.theta + k as f64 * step,
         },
         score: score as f64 / (HIT as f64 * points.len() as f64),
+        rival,
     })
 }
 
