@@ -45,7 +45,7 @@ enum Command {
     Run(cmd::run::RunArgs),
     /// Map a CARMEN log with GMapping-style particle filter SLAM.
     Slam(cmd::slam::SlamArgs),
-    /// The simulator against reality: replay a real log in a world.
+    /// The simulator: replay a real log in a world; write a simulated run as a log with its truth.
     #[command(subcommand)]
     Sim(cmd::sim::SimCommand),
     /// Simulated worlds: make one from a map.

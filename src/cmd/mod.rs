@@ -12,6 +12,7 @@ pub mod paths;
 pub mod replay_plot;
 pub mod run;
 pub mod sim;
+pub mod sim_log;
 pub mod slam;
 pub mod study;
 pub mod viz;

@@ -1,4 +1,5 @@
-//! `mrslam sim replay LOG --world WORLD.toml`: the simulator's lidar checked against a real log's scans.
+//! `mrslam sim replay LOG --world WORLD.toml`: the simulator's lidar checked against a real log's scans;
+//! `mrslam sim log` (in `sim_log`) writes a simulated run as a log.
 
 use super::replay_plot;
 use anyhow::{Context, Result, bail};
@@ -68,11 +69,15 @@ pub enum SimCommand {
         #[arg(long)]
         fit_odometry: bool,
     },
+    /// Write a simulated run as benchmark data: per robot a CARMEN log, its true trajectory and the relations
+    /// the truth implies (Kümmerle's format), to score any SLAM on the testbed's worlds.
+    Log(super::sim_log::LogArgs),
 }
 
 /// Runs a sim subcommand.
 pub fn run(cmd: SimCommand) -> Result<ExitCode> {
     match cmd {
+        SimCommand::Log(args) => return super::sim_log::run(args),
         SimCommand::Replay {
             log,
             world,

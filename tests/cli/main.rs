@@ -10,6 +10,7 @@ mod merge_many;
 mod reliability;
 mod run;
 mod sim;
+mod sim_log;
 mod slam;
 mod study;
 mod study_logs;

@@ -20,7 +20,7 @@
 #![deny(missing_docs)]
 
 // Private modules, their user-facing items re-exported below; `input`, `map_io`, `output`, `pose`,
-// `relations` and `toml_lines` are public namespaces of functions (`map_io::read_ros_map`,
+// `relations`, `toml_lines` and `truth_relations` are public namespaces of functions (`map_io::read_ros_map`,
 // `output::write_file_atomic`, `pose::normalize_angle`, `relations::score`), their items not re-exported.
 mod grid;
 pub mod input;
@@ -33,6 +33,7 @@ mod scan;
 mod se2;
 pub mod sensor;
 pub mod toml_lines;
+pub mod truth_relations;
 
 pub use grid::{
     CellState, FREE_LOGODDS, GridError, LogOddsParams, MAX_CELLS, OCCUPIED_LOGODDS, OccupancyGrid, floor_i64, log_odds,

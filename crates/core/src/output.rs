@@ -15,9 +15,7 @@ pub struct WriteError {
 
 /// Writes `bytes` to `path` through a temporary file in the same folder and a rename.
 pub fn write_file_atomic(path: &Path, bytes: &[u8]) -> Result<(), WriteError> {
-    let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
-    let name = path.file_name().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
-    let tmp = dir.join(format!(".{name}.tmp{}", std::process::id()));
+    let tmp = temporary_name(path);
     let result = (|| {
         let mut f = std::fs::File::create(&tmp)?;
         f.write_all(bytes)?;
@@ -31,9 +29,88 @@ pub fn write_file_atomic(path: &Path, bytes: &[u8]) -> Result<(), WriteError> {
     Ok(())
 }
 
+/// A file written as a stream that appears under its name only when [`AtomicFile::commit`] is called: until
+/// then the bytes go to a hidden temporary file beside it, removed if the writer is dropped uncommitted.
+pub struct AtomicFile {
+    path: PathBuf,
+    tmp: PathBuf,
+    writer: Option<std::io::BufWriter<std::fs::File>>,
+}
+
+impl AtomicFile {
+    /// Starts writing `path` (through a temporary file in the same folder).
+    pub fn create(path: &Path) -> Result<Self, WriteError> {
+        let tmp = temporary_name(path);
+        let file = std::fs::File::create(&tmp).map_err(|cause| WriteError { path: path.to_path_buf(), cause })?;
+        Ok(Self { path: path.to_path_buf(), tmp, writer: Some(std::io::BufWriter::new(file)) })
+    }
+
+    /// The file's final name.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// Flushes, syncs and renames the temporary file to the final name.
+    pub fn commit(mut self) -> Result<(), WriteError> {
+        let result = (|| {
+            let writer = self.writer.take().ok_or_else(|| std::io::Error::other("already committed"))?;
+            let file = writer.into_inner().map_err(|e| e.into_error())?;
+            file.sync_all()?;
+            std::fs::rename(&self.tmp, &self.path)
+        })();
+        result.map_err(|cause| WriteError { path: self.path.clone(), cause })
+    }
+
+    fn writer(&mut self) -> std::io::Result<&mut std::io::BufWriter<std::fs::File>> {
+        self.writer.as_mut().ok_or_else(|| std::io::Error::other("already committed"))
+    }
+}
+
+impl std::io::Write for AtomicFile {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        self.writer()?.write(buf)
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.writer()?.flush()
+    }
+}
+
+impl Drop for AtomicFile {
+    fn drop(&mut self) {
+        if self.writer.take().is_some() {
+            let _ = std::fs::remove_file(&self.tmp);
+        }
+    }
+}
+
+/// The hidden temporary name `path` is written under before its rename.
+fn temporary_name(path: &Path) -> PathBuf {
+    let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let name = path.file_name().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+    dir.join(format!(".{name}.tmp{}", std::process::id()))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_streamed_file_appears_only_when_committed() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("log.clf");
+        let mut f = AtomicFile::create(&p).unwrap();
+        f.write_all(b"ODOM 0 0 0\n").unwrap();
+        assert!(!p.exists(), "visible before commit");
+        drop(f);
+        assert!(!p.exists());
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0, "the temporary file is left behind");
+        let mut f = AtomicFile::create(&p).unwrap();
+        f.write_all(b"ODOM 1 0 0\n").unwrap();
+        f.commit().unwrap();
+        assert_eq!(std::fs::read_to_string(&p).unwrap(), "ODOM 1 0 0\n");
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+    }
 
     #[test]
     fn a_file_is_written_whole_or_not_at_all() {

@@ -146,6 +146,21 @@ pub fn format_trajectory(header: &str, poses: &[StampedPose]) -> String {
     text
 }
 
+/// Formats relations as `t1 t2 x y z roll pitch yaw` lines (z, roll and pitch 0) after `header` (each header
+/// line gets a `# `): the layout [`parse_relations`] reads.
+pub fn format_relations(header: &str, relations: &[Relation]) -> String {
+    use std::fmt::Write as _;
+    let mut text = String::with_capacity(header.len() + 80 * relations.len());
+    for l in header.lines() {
+        let _ = writeln!(text, "# {l}");
+    }
+    for r in relations {
+        let Xyt { x, y, theta: t } = Xyt::from_pose(&r.delta);
+        let _ = writeln!(text, "{:.6} {:.6} {x:.6} {y:.6} 0 0 0 {t:.6}", r.t1, r.t2);
+    }
+    text
+}
+
 /// The error of one relation.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RelationError {

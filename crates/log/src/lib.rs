@@ -16,9 +16,10 @@
 
 #![deny(missing_docs)]
 
-// Private modules, their items re-exported below; `carmen` (the CARMEN reader) and `repair` (the repairs)
-// are public namespaces of functions, their items not re-exported.
+// Private modules, their items re-exported below; `carmen` (the CARMEN reader), `carmen_writer` (the CARMEN
+// writer) and `repair` (the repairs) are public namespaces, their items not re-exported.
 pub mod carmen;
+pub mod carmen_writer;
 mod error;
 mod options;
 mod read;

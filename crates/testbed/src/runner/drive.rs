@@ -2,7 +2,7 @@
 //! that came in are fed to the robots' SLAM back-ends, all robots side by side.
 
 use super::agent::{Agent, Reading};
-use super::options::{RunError, RunOptions};
+use super::options::{RunError, RunOptions, ScanTaken};
 use super::record::{viz_slam, viz_step};
 use crate::controller::Controller;
 use crate::scenario::{MergeWhen, Scenario};
@@ -58,6 +58,14 @@ pub(super) fn drive(
                 batch.push((scan, sim.odometry(a.id)?, pose));
             }
             batches.push(batch);
+        }
+        if let Some(tap) = opts.on_scan.as_mut() {
+            for (k, (a, batch)) in agents.iter().zip(&batches).enumerate() {
+                for (scan, odometry, true_pose) in batch {
+                    let mount = &a.setup.lidar.mount;
+                    tap(&ScanTaken { robot: k, name: &a.setup.name, scan, odometry, true_pose, mount });
+                }
+            }
         }
         if let Some(v) = opts.viz.as_deref_mut() {
             viz_step(v, steps, sim.time(), agents, &events, &batches);

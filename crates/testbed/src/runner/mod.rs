@@ -13,7 +13,7 @@ mod options;
 mod outputs;
 mod record;
 
-pub use options::{RunError, RunOptions, RunOutput};
+pub use options::{RunError, RunOptions, RunOutput, ScanTaken, ScanTap};
 pub use outputs::{merge_overlay, write_outputs};
 pub use record::merge_view;
 

@@ -2,7 +2,7 @@
 
 use crate::report::RunReport;
 use mrslam_core::map_io::MapIoError;
-use mrslam_core::{OccupancyGrid, Pose2};
+use mrslam_core::{LaserScan, OccupancyGrid, Odometry, Pose2};
 use mrslam_merge::{Algorithm, MergeOutcome};
 use mrslam_sim::SimError;
 use mrslam_slam::SlamError;
@@ -41,6 +41,28 @@ pub struct RunOptions<'a> {
     pub progress: Option<Box<dyn FnMut(f64, f64) + 'a>>,
     /// Records the run for the rerun viewer; `None` (the default) records and converts nothing.
     pub viz: Option<&'a mut RunRecorder>,
+    /// Called with every scan a robot takes, before its SLAM sees it (e.g. to write the run as a log).
+    pub on_scan: Option<ScanTap<'a>>,
+}
+
+/// What [`RunOptions::on_scan`] calls with each scan.
+pub type ScanTap<'a> = Box<dyn FnMut(&ScanTaken<'_>) + 'a>;
+
+/// A scan a robot took, with what a log of the run would hold beside it.
+#[derive(Debug, Clone, Copy)]
+pub struct ScanTaken<'s> {
+    /// The robot's index in the scenario's robot order.
+    pub robot: usize,
+    /// The robot's name.
+    pub name: &'s str,
+    /// The scan (stamped with the simulation time).
+    pub scan: &'s LaserScan,
+    /// The robot's wheel odometry at the scan.
+    pub odometry: &'s Odometry,
+    /// The robot's true pose at the scan, in the world frame.
+    pub true_pose: &'s Pose2,
+    /// The lidar's mount on the robot.
+    pub mount: &'s Pose2,
 }
 
 /// Everything a run produced.

@@ -1,0 +1,209 @@
+//! `mrslam sim log SCENARIO.toml --out DIR`: a simulated run written as benchmark data: per robot a CARMEN
+//! log, its true trajectory and the relations the truth implies (Kümmerle's format), so any SLAM, ours or
+//! another, can be scored on the testbed's worlds.
+
+use anyhow::{Context, Result, bail};
+use clap::Args;
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use mrslam_core::output::{AtomicFile, write_file_atomic};
+use mrslam_core::relations::{StampedPose, format_relations, format_trajectory};
+use mrslam_core::truth_relations::{TruthRelations, relations_from_truth};
+use mrslam_log::carmen_writer::CarmenWriter;
+use mrslam_testbed::runner::{RunOptions, ScanTaken, run as run_scenario};
+use mrslam_testbed::scenario::Scenario;
+use serde_json::json;
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+/// Arguments of `mrslam sim log`.
+#[derive(Args)]
+pub struct LogArgs {
+    /// Scenario file (TOML): its robots drive as in `mrslam run` (no merge is made).
+    pub scenario: PathBuf,
+    /// Output folder: per robot NAME.clf (the log), NAME.truth (`stamp x y theta`, the robot's true pose at
+    /// every scan, world frame), NAME.relations (relations drawn from the truth), and log.json (a summary).
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Override the scenario's seed.
+    #[arg(long, allow_negative_numbers = true)]
+    pub seed: Option<u64>,
+    /// Write no ODOM lines: the odometry is only in the scan lines, as in some benchmark logs.
+    #[arg(long)]
+    pub no_odom_lines: bool,
+    /// Loop relations join poses at most this far apart, metres (local ones every metre of driving).
+    #[arg(long, default_value_t = TruthRelations::default().loop_radius)]
+    pub loop_radius: f64,
+    /// ... with at least this many metres of driving between them.
+    #[arg(long, default_value_t = TruthRelations::default().loop_min_travel)]
+    pub loop_min_travel: f64,
+    /// No progress bar.
+    #[arg(long)]
+    pub quiet: bool,
+}
+
+/// One robot's log as it is written.
+struct RobotLog {
+    name: String,
+    writer: CarmenWriter<AtomicFile>,
+    truth: Vec<StampedPose>,
+    beams: usize,
+    range_max: f32,
+}
+
+/// The files `mrslam sim log` writes for robot `name` in `dir`.
+fn robot_files(dir: &Path, name: &str) -> [PathBuf; 3] {
+    ["clf", "truth", "relations"].map(|ext| dir.join(format!("{name}.{ext}")))
+}
+
+/// Runs `mrslam sim log`.
+pub fn run(args: LogArgs) -> Result<ExitCode> {
+    let truth_params =
+        TruthRelations { loop_radius: args.loop_radius, loop_min_travel: args.loop_min_travel, ..Default::default() };
+    if !(truth_params.loop_radius > 0.0 && truth_params.loop_radius.is_finite()) {
+        bail!("--loop-radius {}: must be a positive number of metres", args.loop_radius);
+    }
+    if !(truth_params.loop_min_travel >= 0.0 && truth_params.loop_min_travel.is_finite()) {
+        bail!("--loop-min-travel {}: must be a number of metres, 0 or more", args.loop_min_travel);
+    }
+    let mut scenario = Scenario::from_file(&args.scenario)?;
+    if let Some(s) = args.seed {
+        scenario.seed = s;
+    }
+    std::fs::create_dir_all(&args.out)
+        .map_err(|e| anyhow::anyhow!("{}: cannot create output folder: {e}", args.out.display()))?;
+    let summary_path = args.out.join("log.json");
+    let mut outputs = vec![summary_path.clone()];
+    for r in &scenario.robots {
+        outputs.extend(robot_files(&args.out, &r.name));
+    }
+    let inputs: Vec<&Path> = vec![args.scenario.as_path(), scenario.world_path.as_path()];
+    for o in &outputs {
+        super::paths::check_not_input(o, &inputs)?;
+    }
+    let mut logs = Vec::new();
+    for r in &scenario.robots {
+        let [clf, ..] = robot_files(&args.out, &r.name);
+        let header = format!(
+            "mrslam sim log: robot `{}` of scenario `{}` ({}), seed {}\ntrue trajectory: {}.truth; relations: {}.relations",
+            r.name,
+            scenario.name,
+            args.scenario.display(),
+            scenario.seed,
+            r.name,
+            r.name
+        );
+        let file = AtomicFile::create(&clf)?;
+        let writer = CarmenWriter::new(file, &header).with_context(|| clf.display().to_string())?;
+        logs.push(RobotLog { name: r.name.clone(), writer, truth: Vec::new(), beams: 0, range_max: 0.0 });
+    }
+    let bar = ProgressBar::new((scenario.duration * 10.0) as u64);
+    if args.quiet || !std::io::stderr().is_terminal() {
+        bar.set_draw_target(ProgressDrawTarget::hidden());
+    }
+    bar.set_style(
+        ProgressStyle::with_template("{msg} [{bar:40}] {prefix} sim s, {elapsed} wall, ETA {eta}")
+            .expect("valid template")
+            .progress_chars("=> "),
+    );
+    bar.set_message(scenario.name.clone());
+    let mut write_error: Option<anyhow::Error> = None;
+    let odom_lines = !args.no_odom_lines;
+    let tap = |s: &ScanTaken<'_>| {
+        if write_error.is_some() {
+            return;
+        }
+        let log = &mut logs[s.robot];
+        let written = (|| {
+            if odom_lines {
+                log.writer.odometry(s.odometry)?;
+            }
+            log.writer.scan(s.scan, s.odometry, s.mount)
+        })();
+        if let Err(e) = written {
+            write_error = Some(anyhow::anyhow!("{}.clf: {e}", log.name));
+        }
+        log.truth.push(StampedPose { stamp: s.scan.stamp, pose: *s.true_pose });
+        log.beams = s.scan.len();
+        log.range_max = s.scan.range_max;
+    };
+    let opts = RunOptions {
+        // A log needs no merge.
+        algorithms: Some(Vec::new()),
+        progress: Some(Box::new(|t: f64, end: f64| {
+            bar.set_length((end.max(t) * 10.0) as u64);
+            bar.set_position((t * 10.0) as u64);
+            bar.set_prefix(format!("{t:.0}/{end:.0}"));
+        })),
+        viz: None,
+        on_scan: Some(Box::new(tap)),
+    };
+    let out = run_scenario(&scenario, opts)?;
+    bar.finish_and_clear();
+    if let Some(e) = write_error {
+        return Err(e);
+    }
+    let mut robots = Vec::new();
+    for log in logs {
+        let [clf, truth_path, relations_path] = robot_files(&args.out, &log.name);
+        let file = log.writer.finish().with_context(|| clf.display().to_string())?;
+        file.commit()?;
+        let header = format!("true pose of robot `{}` at each scan of {}.clf, world frame", log.name, log.name);
+        write_file_atomic(&truth_path, format_trajectory(&header, &log.truth).as_bytes())?;
+        let drawn = relations_from_truth(&log.truth, &truth_params);
+        let header = format!(
+            "relations of {}.clf drawn from its true trajectory: {} local (1 m or 0.5 rad apart), {} across loops \
+             (within {} m after at least {} m of driving)",
+            log.name,
+            drawn.local.len(),
+            drawn.loops.len(),
+            truth_params.loop_radius,
+            truth_params.loop_min_travel
+        );
+        write_file_atomic(&relations_path, format_relations(&header, &drawn.all()).as_bytes())?;
+        let duration = match (log.truth.first(), log.truth.last()) {
+            (Some(a), Some(b)) => b.stamp - a.stamp,
+            _ => 0.0,
+        };
+        let distance = out.report.robots.get(&log.name).map_or(0.0, |r| r.distance_m);
+        let longest = drawn.loop_lengths.iter().copied().fold(0.0, f64::max);
+        println!(
+            "{:<10} {} scans ({} beams, {} m range) over {:.0} s, {:.0} m driven; relations: {} local, {} across \
+             loops (longest loop {:.0} m)",
+            log.name,
+            log.truth.len(),
+            log.beams,
+            log.range_max,
+            duration,
+            distance,
+            drawn.local.len(),
+            drawn.loops.len(),
+            longest
+        );
+        robots.push(json!({
+            "name": log.name,
+            "log": clf.file_name().map(|n| n.to_string_lossy().into_owned()),
+            "scans": log.truth.len(),
+            "beams": log.beams,
+            "range_max_m": log.range_max,
+            "duration_s": duration,
+            "distance_m": distance,
+            "local_relations": drawn.local.len(),
+            "loop_relations": drawn.loops.len(),
+            "longest_loop_m": longest,
+            "odom_lines": odom_lines,
+        }));
+    }
+    let summary = json!({
+        "scenario": scenario.name,
+        "scenario_file": args.scenario.display().to_string(),
+        "seed": scenario.seed,
+        "sim_s": out.report.sim_s,
+        "wall_s": out.report.wall_s,
+        "robots": robots,
+    });
+    let text = serde_json::to_string_pretty(&summary).context("log.json")? + "\n";
+    write_file_atomic(&summary_path, text.as_bytes())?;
+    println!("outputs:  {}", args.out.display());
+    Ok(ExitCode::SUCCESS)
+}
