@@ -81,7 +81,7 @@ pub fn run(args: RunArgs) -> Result<ExitCode> {
             bar.set_prefix(format!("{t:.0}/{end:.0}"));
         })),
         viz: viz.as_mut(),
-        on_scan: None,
+        on_step: None,
     };
     let out = run_scenario(&scenario, opts)?;
     bar.finish_and_clear();

@@ -6,12 +6,15 @@ use anyhow::{Context, Result, bail};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use mrslam_core::output::{AtomicFile, write_file_atomic};
+use mrslam_core::pose::interpolate;
 use mrslam_core::relations::{StampedPose, format_relations, format_trajectory};
 use mrslam_core::truth_relations::{TruthRelations, relations_from_truth};
+use mrslam_core::{Odometry, Pose2};
 use mrslam_log::carmen_writer::CarmenWriter;
-use mrslam_testbed::runner::{RunOptions, ScanTaken, run as run_scenario};
+use mrslam_testbed::runner::{RobotStep, RunOptions, run as run_scenario};
 use mrslam_testbed::scenario::Scenario;
 use serde_json::json;
+use std::collections::VecDeque;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -49,6 +52,25 @@ struct RobotLog {
     truth: Vec<StampedPose>,
     beams: usize,
     range_max: f32,
+    /// (time, true pose, odometry pose) at the ends of the last steps, oldest first.
+    history: VecDeque<(f64, Pose2, Pose2)>,
+}
+
+/// Steps of history kept: more than a scan period of the slowest lidar.
+const HISTORY: usize = 400;
+
+/// The true pose and odometry pose at `stamp`, interpolated between the steps that bracket it (the nearest
+/// end of the history outside it).
+fn at_stamp(history: &VecDeque<(f64, Pose2, Pose2)>, stamp: f64) -> Option<(Pose2, Pose2)> {
+    let k = history.partition_point(|h| h.0 < stamp);
+    let (a, b) = match (k.checked_sub(1).and_then(|i| history.get(i)), history.get(k)) {
+        (Some(a), Some(b)) => (a, b),
+        (Some(a), None) => (a, a),
+        (None, Some(b)) => (b, b),
+        (None, None) => return None,
+    };
+    let s = if b.0 > a.0 { ((stamp - a.0) / (b.0 - a.0)).clamp(0.0, 1.0) } else { 0.0 };
+    Some((interpolate(&a.1, &b.1, s), interpolate(&a.2, &b.2, s)))
 }
 
 /// The files `mrslam sim log` writes for robot `name` in `dir`.
@@ -95,7 +117,14 @@ pub fn run(args: LogArgs) -> Result<ExitCode> {
         );
         let file = AtomicFile::create(&clf)?;
         let writer = CarmenWriter::new(file, &header).with_context(|| clf.display().to_string())?;
-        logs.push(RobotLog { name: r.name.clone(), writer, truth: Vec::new(), beams: 0, range_max: 0.0 });
+        logs.push(RobotLog {
+            name: r.name.clone(),
+            writer,
+            truth: Vec::new(),
+            beams: 0,
+            range_max: 0.0,
+            history: VecDeque::new(),
+        });
     }
     let bar = ProgressBar::new((scenario.duration * 10.0) as u64);
     if args.quiet || !std::io::stderr().is_terminal() {
@@ -109,23 +138,34 @@ pub fn run(args: LogArgs) -> Result<ExitCode> {
     bar.set_message(scenario.name.clone());
     let mut write_error: Option<anyhow::Error> = None;
     let odom_lines = !args.no_odom_lines;
-    let tap = |s: &ScanTaken<'_>| {
+    let tap = |s: &RobotStep<'_>| {
         if write_error.is_some() {
             return;
         }
         let log = &mut logs[s.robot];
-        let written = (|| {
-            if odom_lines {
-                log.writer.odometry(s.odometry)?;
-            }
-            log.writer.scan(s.scan, s.odometry, s.mount)
-        })();
-        if let Err(e) = written {
-            write_error = Some(anyhow::anyhow!("{}.clf: {e}", log.name));
+        log.history.push_back((s.time, *s.true_pose, s.odometry.pose));
+        if log.history.len() > HISTORY {
+            log.history.pop_front();
         }
-        log.truth.push(StampedPose { stamp: s.scan.stamp, pose: *s.true_pose });
-        log.beams = s.scan.len();
-        log.range_max = s.scan.range_max;
+        for scan in s.scans {
+            // The scan was taken from its stamp on, up to a scan period before this step's end.
+            let (true_pose, odometry_pose) =
+                at_stamp(&log.history, scan.stamp).unwrap_or((*s.true_pose, s.odometry.pose));
+            let odometry = Odometry { stamp: scan.stamp, pose: odometry_pose };
+            let written = (|| {
+                if odom_lines {
+                    log.writer.odometry(&odometry)?;
+                }
+                log.writer.scan(scan, &odometry, s.mount)
+            })();
+            if let Err(e) = written {
+                write_error = Some(anyhow::anyhow!("{}.clf: {e}", log.name));
+                return;
+            }
+            log.truth.push(StampedPose { stamp: scan.stamp, pose: true_pose });
+            log.beams = scan.len();
+            log.range_max = scan.range_max;
+        }
     };
     let opts = RunOptions {
         // A log needs no merge.
@@ -136,7 +176,7 @@ pub fn run(args: LogArgs) -> Result<ExitCode> {
             bar.set_prefix(format!("{t:.0}/{end:.0}"));
         })),
         viz: None,
-        on_scan: Some(Box::new(tap)),
+        on_step: Some(Box::new(tap)),
     };
     let out = run_scenario(&scenario, opts)?;
     bar.finish_and_clear();

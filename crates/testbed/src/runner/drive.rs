@@ -2,11 +2,11 @@
 //! that came in are fed to the robots' SLAM back-ends, all robots side by side.
 
 use super::agent::{Agent, Reading};
-use super::options::{RunError, RunOptions, ScanTaken};
+use super::options::{RobotStep, RunError, RunOptions};
 use super::record::{viz_slam, viz_step};
 use crate::controller::Controller;
 use crate::scenario::{MergeWhen, Scenario};
-use mrslam_core::OccupancyGrid;
+use mrslam_core::{LaserScan, OccupancyGrid};
 use mrslam_sim::Sim;
 use nalgebra::Point2;
 use rayon::prelude::*;
@@ -59,12 +59,20 @@ pub(super) fn drive(
             }
             batches.push(batch);
         }
-        if let Some(tap) = opts.on_scan.as_mut() {
+        if let Some(tap) = opts.on_step.as_mut() {
+            let time = sim.time();
             for (k, (a, batch)) in agents.iter().zip(&batches).enumerate() {
-                for (scan, odometry, true_pose) in batch {
-                    let mount = &a.setup.lidar.mount;
-                    tap(&ScanTaken { robot: k, name: &a.setup.name, scan, odometry, true_pose, mount });
-                }
+                let odometry = sim.odometry(a.id)?;
+                let scans: Vec<&LaserScan> = batch.iter().map(|(scan, ..)| scan).collect();
+                tap(&RobotStep {
+                    robot: k,
+                    name: &a.setup.name,
+                    time,
+                    true_pose: &a.last,
+                    odometry: &odometry,
+                    scans: &scans,
+                    mount: &a.setup.lidar.mount,
+                });
             }
         }
         if let Some(v) = opts.viz.as_deref_mut() {

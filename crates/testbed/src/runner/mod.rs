@@ -13,7 +13,7 @@ mod options;
 mod outputs;
 mod record;
 
-pub use options::{RunError, RunOptions, RunOutput, ScanTaken, ScanTap};
+pub use options::{RobotStep, RunError, RunOptions, RunOutput, StepTap};
 pub use outputs::{merge_overlay, write_outputs};
 pub use record::merge_view;
 

@@ -41,26 +41,30 @@ pub struct RunOptions<'a> {
     pub progress: Option<Box<dyn FnMut(f64, f64) + 'a>>,
     /// Records the run for the rerun viewer; `None` (the default) records and converts nothing.
     pub viz: Option<&'a mut RunRecorder>,
-    /// Called with every scan a robot takes, before its SLAM sees it (e.g. to write the run as a log).
-    pub on_scan: Option<ScanTap<'a>>,
+    /// Called after every simulation step for every robot, with the scans that came in (e.g. to write the run
+    /// as a log), before its SLAM sees them.
+    pub on_step: Option<StepTap<'a>>,
 }
 
-/// What [`RunOptions::on_scan`] calls with each scan.
-pub type ScanTap<'a> = Box<dyn FnMut(&ScanTaken<'_>) + 'a>;
+/// What [`RunOptions::on_step`] calls for each robot after each step.
+pub type StepTap<'a> = Box<dyn FnMut(&RobotStep<'_>) + 'a>;
 
-/// A scan a robot took, with what a log of the run would hold beside it.
+/// A robot after one simulation step: its true pose and odometry then, and the scans that came in.
 #[derive(Debug, Clone, Copy)]
-pub struct ScanTaken<'s> {
+pub struct RobotStep<'s> {
     /// The robot's index in the scenario's robot order.
     pub robot: usize,
     /// The robot's name.
     pub name: &'s str,
-    /// The scan (stamped with the simulation time).
-    pub scan: &'s LaserScan,
-    /// The robot's wheel odometry at the scan.
-    pub odometry: &'s Odometry,
-    /// The robot's true pose at the scan, in the world frame.
+    /// Simulation time at the end of the step, seconds.
+    pub time: f64,
+    /// The robot's true pose at the end of the step, in the world frame.
     pub true_pose: &'s Pose2,
+    /// The robot's wheel odometry at the end of the step.
+    pub odometry: &'s Odometry,
+    /// Scans published during the step. Each is stamped when its first beam was cast, up to a scan period
+    /// before the step's end: a log pairs it with the pose and odometry at its stamp, not at the step's end.
+    pub scans: &'s [&'s LaserScan],
     /// The lidar's mount on the robot.
     pub mount: &'s Pose2,
 }
