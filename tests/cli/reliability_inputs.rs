@@ -82,7 +82,7 @@ fn files_of_the_wrong_kind_are_refused() {
     fails_with(&["log", "info", p(&notes)], &["notes.log: no laser scans", "not a CARMEN laser log?"]);
     let rels = d.join("r.relations.log");
     std::fs::write(&rels, "1.0 2.0 0.5 0 0 0 0 0.1\n2.0 3.0 0.5 0 0 0 0 0.1\n").unwrap();
-    fails_with(&["log", "info", p(&rels)], &["no laser scans", "2 `1.0`"]);
+    fails_with(&["log", "info", p(&rels)], &["no laser scans", "skipped: 1 `1.0`, 1 `2.0`"]);
     // A relations file as the trajectory.
     let r = d.join("r.relations");
     std::fs::copy(&rels, &r).unwrap();

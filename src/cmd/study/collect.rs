@@ -30,8 +30,9 @@ pub(super) fn run(a: CollectArgs) -> Result<ExitCode> {
             bail!("--out {}: is one of the shard folders; its results.csv would be overwritten", a.out.display());
         }
     }
-    let (params, missing) = collect_params(&a.dirs, a.partial)?;
+    // A trial found twice (a shard given twice) first, then shards of other studies or missing ones.
     let rows = collect(&a.dirs)?;
+    let (params, missing) = collect_params(&a.dirs, a.partial)?;
     create_out(&a.out)?;
     if let Some(p) = &params {
         p.write(&a.out)?;
