@@ -60,10 +60,10 @@ impl Outputs {
     pub fn check(&self) -> Result<()> {
         let inputs: Vec<&Path> = self.inputs.iter().map(PathBuf::as_path).collect();
         for (what, path, kind) in &self.outputs {
+            check_output(path).map_err(|e| anyhow::anyhow!("{what} {e}"))?;
             if !kind.is_empty() {
                 check_extension(path, what, kind)?;
             }
-            check_output(path).map_err(|e| anyhow::anyhow!("{what} {e}"))?;
             check_not_input(path, &inputs).map_err(|e| anyhow::anyhow!("{what} {e}"))?;
         }
         for (i, (what_a, a, _)) in self.outputs.iter().enumerate() {
@@ -112,7 +112,8 @@ mod tests {
         assert!(e.contains("--trajectory") && e.contains("s.yaml"), "{e}");
         let e = rule(&d.join("s.yaml"), &d.join("s.pgm")).unwrap_err();
         assert!(e.contains("`.pgm` is not a format written here; expected .txt or .dat"), "{e}");
-        let both = Outputs::default().file("--summary", &d.join("s.png"), kind::PNG).file("-o", &d.join("s.yml"), kind::MAP);
+        let both =
+            Outputs::default().file("--summary", &d.join("s.png"), kind::PNG).file("-o", &d.join("s.yml"), kind::MAP);
         let e = both.check().unwrap_err().to_string();
         assert!(e.contains("both would write") && e.contains("s.png"), "{e}");
         // An input, or the image an input map names.

@@ -1,10 +1,10 @@
 //! `mrslam run SCENARIO.toml`: a paper scenario end to end — simulate, map, merge, evaluate, report.
 
+use super::run_folder::RunFolder;
 use anyhow::{Result, bail};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use mrslam_merge::Algorithm;
-use super::run_folder::RunFolder;
 use mrslam_testbed::runner::{RunOptions, output_files, run as run_scenario, write_outputs};
 use mrslam_testbed::scenario::Scenario;
 use mrslam_viz::RunRecorder;
@@ -94,7 +94,8 @@ pub fn run(args: RunArgs) -> Result<ExitCode> {
     let out = run_scenario(&scenario, opts)?;
     bar.finish_and_clear();
     // An interruption waits while the files are moved into place together.
-    let (removed, interrupted) = super::interrupt::moving(|| folder.commit(|staging| Ok(write_outputs(&out, staging)?)));
+    let (removed, interrupted) =
+        super::interrupt::moving(|| folder.commit(|staging| Ok(write_outputs(&out, staging)?)));
     if interrupted {
         eprintln!("mrslam run: interrupted; the outputs were moved into place first ({})", out_dir.display());
         return Ok(ExitCode::from(130));

@@ -3,6 +3,7 @@
 use super::replay_plot;
 use anyhow::{Context, Result, bail};
 use clap::Subcommand;
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use mrslam_core::Pose2;
 use mrslam_core::relations::{self, pose_at};
 use mrslam_log::ScanRecord;
@@ -11,7 +12,6 @@ use mrslam_sim::odometry_fit::{fit, worst_relative};
 use mrslam_sim::replay::{BandStats, OUTLIER_M, ReplayReport, replay};
 use mrslam_sim::{LidarModel, World, WorldSpec};
 use mrslam_testbed::scenario::Scenario;
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde_json::json;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};

@@ -61,10 +61,10 @@ fn absurd_and_negative_numbers_get_their_own_checks() {
     cut(&["--max-shift", "1e9"], &["--max-shift 1000000000", "0..=1000"]);
     cut(&["--seed", "-1"], &["invalid value '-1' for '--seed <SEED>'"]);
     assert!(!a.exists() && !b.exists());
-    let e = fails_with(&["world", "from-map", p(&w), "-o", p(&d.join("w.toml")), "--clearance", "-1"], &[
-        "--clearance -1",
-        "must be a positive number",
-    ]);
+    let e = fails_with(
+        &["world", "from-map", p(&w), "-o", p(&d.join("w.toml")), "--clearance", "-1"],
+        &["--clearance -1", "must be a positive number"],
+    );
     assert!(!e.contains("-- -1"), "{e}");
     fails_with(&["run", "scenarios/paper_two_rooms.toml", "--seed", "-1"], &["invalid value '-1' for '--seed"]);
     // A map of 1e300 m per pixel.

@@ -89,7 +89,8 @@ fn a_run_removes_no_recording_it_did_not_make_and_writes_over_no_input() {
     // The manifest names every file the run wrote, and only those.
     let manifest = std::fs::read_to_string(out.join("run-files.txt")).unwrap();
     let listed: Vec<&str> = manifest.lines().filter(|l| !l.starts_with('#')).collect();
-    let mut expected: Vec<String> = names(&out).into_iter().filter(|n| n != "mine.rrd" && n != "run-files.txt").collect();
+    let mut expected: Vec<String> =
+        names(&out).into_iter().filter(|n| n != "mine.rrd" && n != "run-files.txt").collect();
     expected.sort();
     assert_eq!(listed, expected);
     // A second run without a recording: the first run's recording goes (it no longer matches the report), the
@@ -108,7 +109,10 @@ fn a_run_removes_no_recording_it_did_not_make_and_writes_over_no_input() {
     let scenario = idle_scenario(&here, &here.join("w.toml"), "start_a", "start_b");
     let before: Vec<(String, Vec<u8>)> =
         names(&here).into_iter().map(|n| (n.clone(), std::fs::read(here.join(&n)).unwrap())).collect();
-    fails_with(&["run", p(&scenario), "--quiet", "--out", p(&here)], &["truth.yaml", "refusing to write an output over"]);
+    fails_with(
+        &["run", p(&scenario), "--quiet", "--out", p(&here)],
+        &["truth.yaml", "refusing to write an output over"],
+    );
     let after: Vec<(String, Vec<u8>)> =
         names(&here).into_iter().map(|n| (n.clone(), std::fs::read(here.join(&n)).unwrap())).collect();
     assert_eq!(before, after, "nothing written, nothing removed");

@@ -70,7 +70,11 @@ pub fn parse(reader: impl BufRead, path: &Path, options: &ReadOptions) -> Result
             return Err(LogError::TooLarge { path: path.to_path_buf(), limit: options.max_bytes, compressed: false });
         }
         if n as u64 == line_limit && bytes.last() != Some(&b'\n') {
-            return Err(LogError::LineTooLong { path: path.to_path_buf(), line: line_no, limit: options.max_line_bytes });
+            return Err(LogError::LineTooLong {
+                path: path.to_path_buf(),
+                line: line_no,
+                limit: options.max_line_bytes,
+            });
         }
         let line = std::str::from_utf8(&bytes).map_err(|e| LogError::Io {
             path: path.to_path_buf(),

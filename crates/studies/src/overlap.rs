@@ -106,7 +106,11 @@ impl OverlapStudy {
             return bad("success thresholds and the shift must not be negative".into());
         }
         if self.max_shift_m > mrslam_merge::pairs::MAX_SHIFT_M {
-            return bad(format!("--max-shift {}: must be at most {} m", self.max_shift_m, mrslam_merge::pairs::MAX_SHIFT_M));
+            return bad(format!(
+                "--max-shift {}: must be at most {} m",
+                self.max_shift_m,
+                mrslam_merge::pairs::MAX_SHIFT_M
+            ));
         }
         Ok(())
     }

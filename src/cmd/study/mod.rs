@@ -80,7 +80,13 @@ pub(super) fn progress_bar(len: usize, quiet: bool, what: &str) -> ProgressBar {
 /// A rate of trials as people read it: three significant figures, per minute when under one a second.
 fn rate_text(per_sec: f64) -> String {
     let (rate, unit) = if per_sec < 1.0 { (per_sec * 60.0, "min") } else { (per_sec, "s") };
-    let decimals = if rate >= 100.0 { 0 } else if rate >= 10.0 { 1 } else { 2 };
+    let decimals = if rate >= 100.0 {
+        0
+    } else if rate >= 10.0 {
+        1
+    } else {
+        2
+    };
     format!("{rate:.decimals$}/{unit}")
 }
 

@@ -139,7 +139,10 @@ pub fn parse_map_yaml_with(text: &str, path: &Path, warn: &mut dyn FnMut(String)
             "resolution" => {
                 let r = number("resolution")?;
                 if !(r > 0.0 && r <= MAX_RESOLUTION) {
-                    return Err(bad("resolution", format!("must be positive and at most {MAX_RESOLUTION} metres per pixel, found {}", shown())));
+                    return Err(bad(
+                        "resolution",
+                        format!("must be positive and at most {MAX_RESOLUTION} metres per pixel, found {}", shown()),
+                    ));
                 }
                 resolution = Some(r);
             }

@@ -91,7 +91,11 @@ impl CorrelativeMerger {
                     "no pose shares {min_overlap_m2:.1} m² of known space with an acceptance index of {:.2} or more{}: \
                      the {} tried share {}",
                     p.answer.min_acceptance,
-                    if p.answer.min_margin > 0.0 { " (the significance test lets only the best pose be tried)" } else { "" },
+                    if p.answer.min_margin > 0.0 {
+                        " (the significance test lets only the best pose be tried)"
+                    } else {
+                        ""
+                    },
                     tried.len(),
                     tried.join(", ")
                 )

@@ -1,9 +1,9 @@
 //! A run's files: maps, the truth, merged maps with their pictures, and the report.
 
 use super::options::{RunError, RunOutput};
+use crate::scenario::Scenario;
 use mrslam_core::Pose2;
 use mrslam_core::map_io::{self, MapIoError};
-use crate::scenario::Scenario;
 use mrslam_merge::Algorithm;
 use std::path::{Path, PathBuf};
 
