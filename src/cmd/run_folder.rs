@@ -172,10 +172,11 @@ mod tests {
         let input = dir.path().join("in.rrd");
         std::fs::write(&input, "an input")?;
         let fresh = dir.path().join("fresh");
-        let e = RunFolder::prepare(&fresh, false, vec![fresh.join("x.json")], Some(&input), &[input.clone()])
-            .err()
-            .map(|e| e.to_string())
-            .unwrap_or_default();
+        let e =
+            RunFolder::prepare(&fresh, false, vec![fresh.join("x.json")], Some(&input), std::slice::from_ref(&input))
+                .err()
+                .map(|e| e.to_string())
+                .unwrap_or_default();
         assert!(e.contains("--rrd") && e.contains("refusing to write an output over the input"), "{e}");
         assert!(!fresh.exists());
         Ok(())
