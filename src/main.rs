@@ -5,7 +5,7 @@
 
 mod cmd;
 
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 use std::process::ExitCode;
 
 /// The exit codes, shown under `--help` (README.md has the same table).
@@ -16,7 +16,8 @@ Exit codes:
      and field, or the flag)
   2  `mrslam merge` only: the merge was refused (no reliable transform); no merged map is written. With three
      or more maps: some map could not be placed in the first map's frame (no chain of accepted pairs joins
-     them); the maps that could are merged and written";
+     them); the maps that could are merged and written
+  130  `mrslam run` only: interrupted (Ctrl-C); the output folder's files are as before the run";
 
 /// Multi-robot SLAM and map merging testbed: simulate, map, merge, evaluate.
 #[derive(Parser)]
@@ -68,9 +69,19 @@ fn restore_sigpipe() {
     }
 }
 
+/// The command line, every flag's value allowed to be a negative number: `--seed -1` or `--max-shift -5` is
+/// then refused by the flag's own type or range check, not by clap's advice to write `-- -1`.
+fn command() -> clap::Command {
+    fn negatives(cmd: clap::Command) -> clap::Command {
+        cmd.mut_args(|a| if a.get_action().takes_values() { a.allow_negative_numbers(true) } else { a })
+            .mut_subcommands(negatives)
+    }
+    negatives(Cli::command())
+}
+
 fn main() -> ExitCode {
     restore_sigpipe();
-    let cli = match Cli::try_parse() {
+    let cli = match command().try_get_matches().and_then(|m| Cli::from_arg_matches(&m)) {
         Ok(cli) => cli,
         Err(e) => {
             // clap exits 2 on a usage error; 2 is reserved for a refused merge, so usage errors exit 1.

@@ -42,8 +42,9 @@ pub fn run(cmd: EvalCommand) -> Result<ExitCode> {
                 bail!("--tolerance {tolerance}: must be a non-negative number of seconds");
             }
             if let Some(out) = &json {
-                super::paths::check_extension(out, "--json", &["json"])?;
-                super::paths::check_outputs(&[out], &[&trajectory, &relations])?;
+                super::Outputs::reading([trajectory.as_path(), relations.as_path()])
+                    .file("--json", out, super::kind::JSON)
+                    .check()?;
             }
             let traj = relations::read_trajectory(&trajectory)?;
             let rels = relations::read_relations(&relations)?;

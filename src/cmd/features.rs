@@ -16,7 +16,7 @@ use std::time::Instant;
 pub struct FeaturesArgs {
     /// A PNG or PGM image, or a map YAML (rendered as the merger sees it).
     pub image: PathBuf,
-    /// Write the keypoints and descriptors as JSON (the layout of shared/tools/opencv_sift.py).
+    /// Write the keypoints and descriptors as JSON (the layout of dev/scripts/opencv_sift.py, OpenCV's).
     #[arg(long)]
     pub json: Option<PathBuf>,
     /// Draw the keypoints over the image (PNG).
@@ -35,14 +35,10 @@ pub struct FeaturesArgs {
 
 /// Runs `mrslam features`.
 pub fn run(args: FeaturesArgs) -> Result<ExitCode> {
-    if let Some(p) = &args.json {
-        super::paths::check_extension(p, "--json", &["json"])?;
-    }
-    if let Some(p) = &args.png {
-        super::paths::check_extension(p, "--png", &["png"])?;
-    }
-    let outputs: Vec<&Path> = [&args.json, &args.png].into_iter().flatten().map(PathBuf::as_path).collect();
-    super::paths::check_outputs(&outputs, &[&args.image])?;
+    super::Outputs::reading([args.image.as_path()])
+        .maybe("--json", args.json.as_deref(), super::kind::JSON)
+        .maybe("--png", args.png.as_deref(), super::kind::PNG)
+        .check()?;
     let (img, what) = load(&args.image, args.encoding)?;
     let params = SiftParams { upscale: !args.no_upscale, max_features: args.max_features, ..SiftParams::default() };
     let mut sift = Sift::new(params);
@@ -81,7 +77,7 @@ fn load(path: &Path, encoding: Encoding) -> Result<(GrayImage, &'static str)> {
     Ok((g, "image"))
 }
 
-/// The keypoints as opencv_sift.py writes them.
+/// The keypoints as dev/scripts/opencv_sift.py writes them.
 fn json(f: &Features) -> String {
     let list: Vec<serde_json::Value> = f
         .keypoints

@@ -41,6 +41,7 @@ impl ReadArgs {
             max_step_back: self.max_step_back,
             repair_reversing: !self.keep_reversing,
             scan_latency: self.scan_latency,
+            ..ReadOptions::default()
         };
         Ok(read_log(path, &options)?)
     }
@@ -64,6 +65,20 @@ pub fn run(cmd: LogCommand) -> Result<ExitCode> {
     match cmd {
         LogCommand::Info { log, read } => {
             let parsed = read.read(&log)?;
+            if parsed.scans.is_empty() {
+                let mut skipped: Vec<String> =
+                    parsed.skipped.iter().take(5).map(|(k, n)| format!("{n} `{k}`")).collect();
+                if parsed.skipped.len() > 5 {
+                    skipped.push(format!("lines of {} other kinds", parsed.skipped.len() - 5));
+                }
+                anyhow::bail!(
+                    "{}: no laser scans (FLASER, RLASER or ROBOTLASER1 lines): not a CARMEN laser log? ({} ODOM \
+                     lines; skipped: {})",
+                    log.display(),
+                    parsed.odometry.len(),
+                    if skipped.is_empty() { "nothing".to_string() } else { skipped.join(", ") }
+                );
+            }
             println!("log:       {}", log.display());
             println!("scans:     {}", parsed.scans.len());
             if let (Some(first), Some(last)) = (parsed.scans.first(), parsed.scans.last()) {

@@ -1,12 +1,12 @@
 //! `mrslam map info|convert`: look at and convert ROS map_server maps.
 
-use super::paths::{self, extension};
+use super::paths::extension;
 use anyhow::{Context, Result, bail};
 use clap::Subcommand;
 use mrslam_core::Xyt;
 use mrslam_core::map_io::{self, GreyImage, MapMode, MapYaml};
 use mrslam_core::{OccupancyGrid, map_io::grid_from_image};
-use mrslam_merge::pairs::{PairSpec, cut_pair};
+use mrslam_merge::pairs::{MAX_SHIFT_M, PairSpec, cut_pair};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -25,7 +25,7 @@ pub enum MapCommand {
     Convert {
         /// Input: map YAML, or a PGM/PNG image (read at --resolution, origin 0).
         input: PathBuf,
-        /// Output: .yaml (writes a trinary PGM beside it), .pgm or .png (trinary image only).
+        /// Output: .yaml (writes a trinary PGM and a PNG preview beside it), .pgm or .png (trinary image only).
         output: PathBuf,
         /// Metres per pixel when INPUT is a bare image.
         #[arg(long, default_value_t = 0.05)]
@@ -42,7 +42,7 @@ pub enum MapCommand {
         /// Jaccard overlap of the halves' known cells; negative leaves a gap of that fraction.
         #[arg(long, default_value_t = 0.3, allow_negative_numbers = true)]
         overlap: f64,
-        /// Largest shift of the second half, metres.
+        /// Largest shift of the second half, metres (0..=1000).
         #[arg(long, default_value_t = 5.0)]
         max_shift: f64,
         /// Seed of the cut direction and the move.
@@ -67,8 +67,7 @@ pub fn run(cmd: MapCommand) -> Result<ExitCode> {
             print!("{}", info_text(&map, &grid));
         }
         MapCommand::Convert { input, output, resolution } => {
-            paths::check_output_kind(&output, "OUT", &["yaml", "yml", "pgm", "png"])?;
-            paths::check_outputs(&[&output], &[&input])?;
+            super::Outputs::reading([input.as_path()]).file("OUT", &output, super::kind::ANY_MAP).check()?;
             let grid = load_map(&input, resolution)?;
             save_map(&grid, &output)?;
             println!(
@@ -80,13 +79,17 @@ pub fn run(cmd: MapCommand) -> Result<ExitCode> {
             );
         }
         MapCommand::Cut { map, a, b, overlap, max_shift, seed } => {
+            let spec = PairSpec { overlap, max_shift_m: max_shift, rotate: true };
             if !(-0.9..0.95).contains(&overlap) {
                 bail!("--overlap {overlap}: must lie in [-0.9, 0.95)");
             }
-            for out in [&a, &b] {
-                paths::check_extension(out, "output", &["yaml", "yml"])?;
+            if !(0.0..=MAX_SHIFT_M).contains(&max_shift) {
+                bail!("--max-shift {max_shift}: must be a number of metres in 0..={MAX_SHIFT_M}");
             }
-            paths::check_outputs(&[&a, &b], &[&map])?;
+            super::Outputs::reading([map.as_path()])
+                .file("A", &a, super::kind::MAP)
+                .file("B", &b, super::kind::MAP)
+                .check()?;
             let grid = load_map(&map, 0.05)?;
             let (free, occupied, _) = grid.state_counts();
             if free + occupied < MIN_KNOWN_TO_CUT {
@@ -98,7 +101,6 @@ pub fn run(cmd: MapCommand) -> Result<ExitCode> {
                     grid.height()
                 );
             }
-            let spec = PairSpec { overlap, max_shift_m: max_shift, rotate: true };
             let pair = cut_pair(&grid, &spec, seed);
             if overlap > 0.0 && pair.overlap == 0.0 {
                 bail!("{}: the halves share no known cell although --overlap is {overlap}", map.display());
@@ -115,6 +117,9 @@ pub fn run(cmd: MapCommand) -> Result<ExitCode> {
 
 /// Loads a map from a YAML file, or from a bare image at the given resolution.
 pub fn load_map(path: &Path, resolution: f64) -> Result<OccupancyGrid> {
+    if path.is_dir() {
+        bail!("{}: is a folder; expected a map YAML, or a PGM or PNG image", path.display());
+    }
     match extension(path).as_str() {
         "yaml" | "yml" => read_yaml_map(path),
         "pgm" | "png" => {

@@ -22,8 +22,8 @@ pub struct MergeArgs {
     /// More maps: with three or more, every pair is merged and a spanning tree of the most confident accepted
     /// pairs places each map in the first map's frame; exit 2 when some map joins nothing.
     pub more: Vec<PathBuf>,
-    /// Merged map to write (YAML + PGM beside it); not written when the merge is rejected (with three or more
-    /// maps: when no map joins the first).
+    /// Merged map to write (YAML, with the PGM and a PNG preview beside it); not written when the merge is
+    /// rejected (with three or more maps: when no map joins the first).
     #[arg(short, long)]
     pub output: Option<PathBuf>,
     /// Write the merge report (JSON) here, accepted or not.
@@ -56,25 +56,18 @@ fn refuse_pair_only_flags(args: &MergeArgs) -> Result<()> {
 
 /// Runs `mrslam merge`.
 pub fn run(args: MergeArgs) -> Result<ExitCode> {
-    let kinds: [(&Option<PathBuf>, &str, &[&str]); 4] = [
-        (&args.output, "--output", &["yaml", "yml"]),
-        (&args.report, "--report", &["json"]),
-        (&args.matches_png, "--matches-png", &["png"]),
-        (&args.viz.rrd, "--rrd", &["rrd"]),
-    ];
-    for (path, flag, allowed) in kinds {
-        if let Some(p) = path {
-            super::paths::check_extension(p, flag, allowed)?;
-        }
-    }
-    let outputs: Vec<&Path> = kinds.iter().filter_map(|(p, ..)| p.as_deref()).collect();
-    let inputs: Vec<&Path> = [&args.a, &args.b].into_iter().chain(&args.more).map(PathBuf::as_path).collect();
-    super::paths::check_outputs(&outputs, &inputs)?;
+    super::Outputs::reading([&args.a, &args.b].into_iter().chain(&args.more).map(PathBuf::as_path))
+        .maybe("--output", args.output.as_deref(), super::kind::MAP)
+        .maybe("--report", args.report.as_deref(), super::kind::JSON)
+        .maybe("--matches-png", args.matches_png.as_deref(), super::kind::PNG)
+        .maybe("--rrd", args.viz.rrd.as_deref(), super::kind::RRD)
+        .check()?;
     if !args.more.is_empty() {
         refuse_pair_only_flags(&args)?;
     }
     let a = super::map::read_yaml_map(&args.a)?;
     let b = super::map::read_yaml_map(&args.b)?;
+    super::merge_many::refuse_same_maps(&[args.a.as_path(), args.b.as_path()], &[&a, &b])?;
     let (name_a, name_b) = pair_names(&args.a, &args.b);
     let (algorithm, seed) = (args.merger.algorithm, args.merger.seed);
     let recording_id = format!("merge-{name_a}-{name_b}-{algorithm}-seed{seed}");

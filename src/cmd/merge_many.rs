@@ -18,6 +18,27 @@ pub struct Outputs<'a> {
     pub map: Option<&'a Path>,
 }
 
+/// Refuses a map given twice among `files` (their maps `maps`, in order): by name, by another path to the same
+/// file, or as a copy holding the same cells. Merging a map with itself measures nothing.
+pub fn refuse_same_maps(files: &[&Path], maps: &[&OccupancyGrid]) -> Result<()> {
+    for (i, (fa, a)) in files.iter().zip(maps).enumerate() {
+        for (fb, b) in files.iter().zip(maps).skip(i + 1) {
+            let same_file = fa.canonicalize().ok().is_some_and(|p| fb.canonicalize().ok() == Some(p));
+            if same_file {
+                anyhow::bail!("{} and {}: the same map file given twice", fa.display(), fb.display());
+            }
+            if a == b {
+                anyhow::bail!(
+                    "{} holds the same map as {} (a copy?): merging a map with itself measures nothing",
+                    fb.display(),
+                    fa.display()
+                );
+            }
+        }
+    }
+    Ok(())
+}
+
 /// Runs the N-map merge of the maps in `files`: `maps` holds the first ones, read already; the rest are read here.
 pub fn run(
     files: &[&Path],
@@ -29,6 +50,7 @@ pub fn run(
     for p in &files[maps.len()..] {
         maps.push(super::map::read_yaml_map(p)?);
     }
+    refuse_same_maps(files, &maps.iter().collect::<Vec<_>>())?;
     let out = merge_many(merger, &maps, mp);
     if let Some(p) = to.report {
         let files = files.iter().map(|f| f.display().to_string()).collect();

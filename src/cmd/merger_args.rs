@@ -46,9 +46,9 @@ pub struct MergerArgs {
     pub boundary_walls: BoundaryWalls,
     /// The correlative merger's significance test: its best pose must score this share above every pose clearly
     /// apart from it (Lowe's ratio test), else the merge is refused as ambiguous, naming the rival; 0 turns the
-    /// test off [default: `CorrelativeParams::default().min_margin`, 0.15].
-    #[arg(long, value_parser = margin)]
-    pub min_margin: Option<f64>,
+    /// test off.
+    #[arg(long, value_parser = margin, default_value_t = MergerConfig::default().min_margin)]
+    pub min_margin: f64,
     /// The correlative merger's answer is not checked by the same search the other way round (the other map's
     /// walls on this one's); the check refuses answers that are ambiguous that way.
     #[arg(long)]
@@ -70,7 +70,6 @@ pub struct MergerArgs {
 impl MergerArgs {
     /// The merger the flags describe.
     pub fn config(&self) -> MergerConfig {
-        let defaults = MergerConfig::default();
         MergerConfig {
             algorithm: self.algorithm,
             model: self.model,
@@ -83,7 +82,7 @@ impl MergerArgs {
             // One merge has the machine to itself: the two maps' features on two threads (the studies, which run
             // merges side by side, keep one thread per merge).
             parallel: true,
-            min_margin: self.min_margin.unwrap_or(defaults.min_margin),
+            min_margin: self.min_margin,
             cross_check: !self.one_way,
             seed: self.seed,
         }

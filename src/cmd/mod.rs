@@ -3,22 +3,26 @@
 pub mod args;
 pub mod eval;
 pub mod features;
+pub mod interrupt;
 pub mod log;
 pub mod map;
 pub mod merge;
 pub mod merge_many;
 pub mod merger_args;
+pub mod outputs;
 pub mod paths;
 pub mod replay_plot;
 pub mod run;
+pub mod run_folder;
 pub mod sim;
 pub mod sim_log;
 pub mod slam;
+pub mod slam_eta;
 pub mod study;
 pub mod viz;
 pub mod world;
 
-pub use paths::{check_not_input, check_output};
+pub use outputs::{Outputs, kind};
 
 /// The process's peak resident memory, bytes (Linux: VmHWM of /proc/self/status; `None` elsewhere).
 pub fn peak_memory_bytes() -> Option<u64> {

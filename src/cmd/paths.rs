@@ -1,5 +1,5 @@
-//! Output paths checked before any work: the folder exists, the extension says what is written, and no
-//! output lands on an input or on another output (a map YAML counts with the image beside it).
+//! The facts about paths the output rule ([`super::outputs::Outputs`]) is made of: whether a file can be
+//! written, its extension, the files writing or reading a path touches.
 
 use anyhow::{Result, bail};
 use mrslam_core::map_io;
@@ -37,12 +37,6 @@ pub fn check_extension(path: &Path, what: &str, allowed: &[&str]) -> Result<()> 
     bail!("{what} {}: `.{ext}` is not a format written here; expected {list}", path.display());
 }
 
-/// [`check_output`] and [`check_extension`] at once.
-pub fn check_output_kind(path: &Path, what: &str, allowed: &[&str]) -> Result<()> {
-    check_extension(path, what, allowed)?;
-    check_output(path)
-}
-
 fn is_map_yaml(path: &Path) -> bool {
     matches!(extension(path).as_str(), "yaml" | "yml")
 }
@@ -70,7 +64,7 @@ pub fn read_files(path: &Path) -> Vec<PathBuf> {
 }
 
 /// `path` made absolute with symbolic links resolved; for a file not yet there, its folder's.
-fn resolve(p: &Path) -> Option<PathBuf> {
+pub(super) fn resolve(p: &Path) -> Option<PathBuf> {
     if let Ok(c) = p.canonicalize() {
         return Some(c);
     }
@@ -98,31 +92,6 @@ pub fn check_not_input(output: &Path, inputs: &[&Path]) -> Result<()> {
     Ok(())
 }
 
-/// Fails when two of `outputs` would write the same file (a map YAML counts with its PGM).
-pub fn check_distinct(outputs: &[&Path]) -> Result<()> {
-    for (i, a) in outputs.iter().enumerate() {
-        for b in &outputs[i + 1..] {
-            for fa in written_files(a) {
-                for fb in written_files(b) {
-                    if resolve(&fa).is_some() && resolve(&fa) == resolve(&fb) {
-                        bail!("{} and {}: both would write {}", a.display(), b.display(), fa.display());
-                    }
-                }
-            }
-        }
-    }
-    Ok(())
-}
-
-/// Checks a command's outputs before any work: each can be written, none is an input, no two collide.
-pub fn check_outputs(outputs: &[&Path], inputs: &[&Path]) -> Result<()> {
-    for out in outputs {
-        check_output(out)?;
-        check_not_input(out, inputs)?;
-    }
-    check_distinct(outputs)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -134,7 +103,6 @@ mod tests {
         std::fs::write(&yaml, "image: pic.pgm\nresolution: 0.1\norigin: [0, 0, 0]\n")?;
         assert!(check_not_input(&dir.path().join("pic.pgm"), &[&yaml]).is_err());
         assert!(check_not_input(&dir.path().join("other.yaml"), &[&yaml]).is_ok());
-        assert!(check_distinct(&[&dir.path().join("a.yaml"), &dir.path().join("a.yml")]).is_err());
         assert!(check_extension(Path::new("willow"), "OUT", &["yaml"]).is_err());
         Ok(())
     }

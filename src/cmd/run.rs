@@ -1,14 +1,15 @@
 //! `mrslam run SCENARIO.toml`: a paper scenario end to end — simulate, map, merge, evaluate, report.
 
+use super::run_folder::RunFolder;
 use anyhow::{Result, bail};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use mrslam_merge::Algorithm;
-use mrslam_testbed::runner::{RunOptions, run as run_scenario, write_outputs};
+use mrslam_testbed::runner::{RunOptions, output_files, run as run_scenario, write_outputs};
 use mrslam_testbed::scenario::Scenario;
 use mrslam_viz::RunRecorder;
 use std::io::IsTerminal;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::ExitCode;
 
 /// Arguments of `mrslam run`.
@@ -16,14 +17,16 @@ use std::process::ExitCode;
 pub struct RunArgs {
     /// Scenario file (TOML), e.g. scenarios/paper_corridor.toml.
     pub scenario: PathBuf,
-    /// Output folder (default: out/NAME, NAME being the scenario's name).
+    /// Output folder (default: out/NAME, NAME being the scenario's name; a folder given here is made when its
+    /// parent exists). A run replaces or removes only the files an earlier run wrote there (listed in its
+    /// run-files.txt), and never a file the scenario reads.
     #[arg(long)]
     pub out: Option<PathBuf>,
     /// Merge algorithm to run instead of the scenario's: one name, or `all` to compare them on the same maps.
     #[arg(long)]
     pub algorithm: Option<String>,
     /// Override the scenario's seed.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub seed: Option<u64>,
     /// No progress bar.
     #[arg(long)]
@@ -35,13 +38,6 @@ pub struct RunArgs {
 
 /// Runs `mrslam run`.
 pub fn run(args: RunArgs) -> Result<ExitCode> {
-    if let Some(rrd) = &args.viz.rrd {
-        // A folder or a missing folder is reported when the recording opens.
-        if !rrd.is_dir() {
-            super::paths::check_extension(rrd, "--rrd", &["rrd"])?;
-        }
-        super::paths::check_not_input(rrd, &[&args.scenario])?;
-    }
     let mut scenario = Scenario::from_file(&args.scenario)?;
     if let Some(s) = args.seed {
         scenario.seed = s;
@@ -55,13 +51,26 @@ pub fn run(args: RunArgs) -> Result<ExitCode> {
         },
     };
     let out_dir = args.out.clone().unwrap_or_else(|| PathBuf::from("out").join(&scenario.name));
-    // Fail before a long run if the output folder cannot be made.
-    std::fs::create_dir_all(&out_dir)
-        .map_err(|e| anyhow::anyhow!("{}: cannot create output folder: {e}", out_dir.display()))?;
+    // The files the scenario reads: never written over, even when they sit in the output folder.
+    let mut inputs = vec![args.scenario.clone(), scenario.world_path.clone()];
+    inputs.extend(scenario.world.bitmap.as_ref().map(|b| b.map.clone()));
+    // Before the long run: the folder can be made, and no output lands on an input or on another output.
+    let files = output_files(&scenario, algorithms.as_deref(), &out_dir);
+    let folder = RunFolder::prepare(&out_dir, args.out.is_none(), files, args.viz.rrd.as_deref(), &inputs)?;
     // The same for the recording: a file that cannot be written, or no viewer, fails here.
     let recording_id = format!("{}-seed{}", scenario.name, scenario.seed);
     let name = format!("{} (seed {})", scenario.name, scenario.seed);
     let mut viz = args.viz.open(&recording_id, &name)?.map(RunRecorder::new);
+    // Ctrl-C from here: the folder's files are as they were (this run's are moved there only at the end).
+    super::interrupt::on_ctrl_c(format!(
+        "mrslam run: interrupted: the outputs of {} are as they were before this run (an earlier run's, if any){}",
+        out_dir.display(),
+        args.viz
+            .rrd
+            .as_deref()
+            .map(|r| format!("; the recording so far, without its footer: {}", mrslam_viz::partial_path(r).display()))
+            .unwrap_or_default()
+    ));
     let bar = ProgressBar::new((scenario.duration * 10.0) as u64);
     if args.quiet || !std::io::stderr().is_terminal() {
         bar.set_draw_target(ProgressDrawTarget::hidden());
@@ -85,8 +94,17 @@ pub fn run(args: RunArgs) -> Result<ExitCode> {
     };
     let out = run_scenario(&scenario, opts)?;
     bar.finish_and_clear();
-    write_outputs(&out, &out_dir)?;
-    remove_stale_recordings(&out_dir, args.viz.rrd.as_deref())?;
+    // An interruption waits while the files are moved into place together.
+    let (removed, interrupted) =
+        super::interrupt::moving(|| folder.commit(|staging| Ok(write_outputs(&out, staging)?)));
+    if interrupted {
+        eprintln!("mrslam run: interrupted; the outputs were moved into place first ({})", out_dir.display());
+        return Ok(ExitCode::from(130));
+    }
+    let removed = removed?;
+    for r in removed {
+        println!("removed:  {} (an earlier run's, not written by this one)", r.display());
+    }
     print!("{}", out.report.summary());
     println!("outputs:  {}", out_dir.display());
     if let Some(v) = viz {
@@ -94,25 +112,4 @@ pub fn run(args: RunArgs) -> Result<ExitCode> {
         println!("rerun:    {} ({} rows in {} chunks)", args.viz.describe(), stats.rows, stats.chunks);
     }
     Ok(ExitCode::SUCCESS)
-}
-
-/// Removes the `.rrd` recordings an earlier run left in `dir`, keeping this run's (`keep`, and the partial file
-/// it is being written to): a folder's recording always shows the run whose report and maps sit beside it.
-fn remove_stale_recordings(dir: &Path, keep: Option<&Path>) -> Result<()> {
-    let kept: Vec<PathBuf> = keep
-        .into_iter()
-        .flat_map(|k| [k.to_path_buf(), mrslam_viz::partial_path(k)])
-        .filter_map(|k| k.canonicalize().ok())
-        .collect();
-    let entries = std::fs::read_dir(dir).map_err(|e| anyhow::anyhow!("{}: {e}", dir.display()))?;
-    for entry in entries.flatten() {
-        let path = entry.path();
-        let is_rrd = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("rrd")) && path.is_file();
-        if is_rrd && !path.canonicalize().is_ok_and(|p| kept.contains(&p)) {
-            std::fs::remove_file(&path)
-                .map_err(|e| anyhow::anyhow!("{}: cannot remove a stale recording: {e}", path.display()))?;
-            println!("removed:  {} (the recording of an earlier run)", path.display());
-        }
-    }
-    Ok(())
 }

@@ -4,6 +4,7 @@
 use super::replay_plot;
 use anyhow::{Context, Result, bail};
 use clap::Subcommand;
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use mrslam_core::Pose2;
 use mrslam_core::relations::{self, pose_at};
 use mrslam_log::ScanRecord;
@@ -13,6 +14,7 @@ use mrslam_sim::replay::{BandStats, OUTLIER_M, ReplayReport, replay};
 use mrslam_sim::{LidarModel, World, WorldSpec};
 use mrslam_testbed::scenario::Scenario;
 use serde_json::json;
+use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -68,6 +70,9 @@ pub enum SimCommand {
         /// errors (`mrslam_sim::odometry_fit`) and print them with the errors they give.
         #[arg(long)]
         fit_odometry: bool,
+        /// Hide the progress bar.
+        #[arg(long)]
+        quiet: bool,
     },
     /// Write a simulated run as benchmark data: per robot a CARMEN log, its true trajectory and the relations
     /// the truth implies (Kümmerle's format), to score any SLAM on the testbed's worlds.
@@ -91,6 +96,7 @@ pub fn run(cmd: SimCommand) -> Result<ExitCode> {
             segment_rad,
             seed,
             fit_odometry,
+            quiet,
         } => {
             if !(segment_m > 0.0 && segment_rad > 0.0 && segment_m.is_finite() && segment_rad.is_finite()) {
                 bail!("--segment-m {segment_m} / --segment-rad {segment_rad}: must be positive");
@@ -114,10 +120,11 @@ pub fn run(cmd: SimCommand) -> Result<ExitCode> {
                 )
             });
             if let (Some(r), Some((res, odo))) = (&report, &plots) {
-                super::paths::check_extension(r, "--report", &["json"])?;
-                let outputs: Vec<&Path> =
-                    [Some(r.as_path()), Some(res.as_path()), odo.as_deref()].into_iter().flatten().collect();
-                super::paths::check_outputs(&outputs, &inputs)?;
+                super::Outputs::reading(inputs.iter().copied())
+                    .file("--report", r, super::kind::JSON)
+                    .file("--report (its residuals plot)", res, super::kind::PNG)
+                    .maybe("--report (its odometry plot)", odo.as_deref(), super::kind::PNG)
+                    .check()?;
             }
             if !(tolerance.is_finite() && tolerance >= 0.0) {
                 bail!("--tolerance {tolerance}: must be a non-negative number of seconds");
@@ -156,7 +163,18 @@ pub fn run(cmd: SimCommand) -> Result<ExitCode> {
                 );
             }
             let model = LidarModel::preset(&lidar).context("a lidar preset that clap let through")?;
-            let r = replay(&w, &mount, scans.iter().copied(), (model.range_noise_const, model.range_noise_prop), seed);
+            let bar = ProgressBar::new(scans.len() as u64);
+            if quiet || !std::io::stderr().is_terminal() {
+                bar.set_draw_target(ProgressDrawTarget::hidden());
+            }
+            bar.set_style(
+                ProgressStyle::with_template("replay [{bar:40}] {pos}/{len} scans, {elapsed} elapsed, ETA {eta}")
+                    .expect("valid template")
+                    .progress_chars("=> "),
+            );
+            let noise = (model.range_noise_const, model.range_noise_prop);
+            let r = replay(&w, &mount, scans.iter().copied().inspect(|_| bar.inc(1)), noise, seed);
+            bar.finish_and_clear();
             print!("{}", describe(&r, unplaced, &lidar));
             // Odometry: the log's against the trajectory, and each scenario robot's driven along it.
             let mut odometry = Vec::new();

@@ -2,6 +2,7 @@
 //! log, its true trajectory and the relations the truth implies (Kümmerle's format), so any SLAM, ours or
 //! another, can be scored on the testbed's worlds.
 
+use super::outputs::{Outputs, kind};
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -99,10 +100,12 @@ pub fn run(args: LogArgs) -> Result<ExitCode> {
     for r in &scenario.robots {
         outputs.extend(robot_files(&args.out, &r.name));
     }
-    let inputs: Vec<&Path> = vec![args.scenario.as_path(), scenario.world_path.as_path()];
-    for o in &outputs {
-        super::paths::check_not_input(o, &inputs)?;
-    }
+    let mut inputs = vec![args.scenario.clone(), scenario.world_path.clone()];
+    inputs.extend(scenario.world.bitmap.as_ref().map(|b| b.map.clone()));
+    outputs
+        .iter()
+        .fold(Outputs::reading(inputs.iter().map(PathBuf::as_path)), |rule, o| rule.file("sim log --out", o, kind::ANY))
+        .check()?;
     let mut logs = Vec::new();
     for r in &scenario.robots {
         let [clf, ..] = robot_files(&args.out, &r.name);

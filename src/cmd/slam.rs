@@ -26,7 +26,7 @@ use std::process::ExitCode;
 pub struct SlamArgs {
     /// CARMEN log (.clf/.log, gzipped or not).
     pub log: PathBuf,
-    /// Output map YAML (a PGM is written beside it).
+    /// Output map YAML (the PGM and a PNG preview are written beside it).
     #[arg(short, long)]
     pub output: PathBuf,
     /// Output trajectory: one pose per scan of the log, in stamp order, `stamp x y theta` (best particle,
@@ -143,15 +143,12 @@ impl DriftArgs {
 
 /// Runs `mrslam slam`.
 pub fn run(args: SlamArgs) -> Result<ExitCode> {
-    if let Some(p) = &args.viz.rrd {
-        super::paths::check_extension(p, "--rrd", &["rrd"])?;
-    }
-    let outputs = [Some(&args.output), args.trajectory.as_ref(), args.summary.as_ref(), args.viz.rrd.as_ref()];
-    let inputs: Vec<&std::path::Path> = std::iter::once(args.log.as_path()).chain(args.relations.as_deref()).collect();
-    for p in outputs.into_iter().flatten() {
-        super::check_output(p)?;
-        super::check_not_input(p, &inputs)?;
-    }
+    super::Outputs::reading(std::iter::once(args.log.as_path()).chain(args.relations.as_deref()))
+        .file("--output", &args.output, super::kind::MAP)
+        .maybe("--trajectory", args.trajectory.as_deref(), super::kind::TRAJECTORY)
+        .maybe("--summary", args.summary.as_deref(), super::kind::JSON)
+        .maybe("--rrd", args.viz.rrd.as_deref(), super::kind::RRD)
+        .check()?;
     if !(args.tolerance.is_finite() && args.tolerance >= 0.0) {
         bail!("--tolerance {}: must be a non-negative number of seconds", args.tolerance);
     }
@@ -185,6 +182,11 @@ pub fn run(args: SlamArgs) -> Result<ExitCode> {
 
     let jumps = odometry_jumps(&odo, &log.scans);
 
+    let gate = super::slam_eta::Gate {
+        linear: params.filter.linear_update,
+        angular: params.filter.angular_update,
+        temporal: params.filter.temporal_update,
+    };
     let offset: Pose2 = log.scans[0].laser_offset;
     let mut filter = Rbpf::new(params, offset, args.seed).context("slam parameters")?;
     // The recording's destinations are opened before the long work, so that a bad one fails at once.
@@ -199,8 +201,9 @@ pub fn run(args: SlamArgs) -> Result<ExitCode> {
         bar.set_draw_target(ProgressDrawTarget::hidden());
     }
     bar.set_style(
-        ProgressStyle::with_template("{bar:40} {pos}/{len} scans {msg} [{elapsed_precise}<{eta_precise}]")
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+        ProgressStyle::with_template("{bar:40} {pos}/{len} scans {msg} [{elapsed_precise}<{work_eta}]")
+            .unwrap_or_else(|_| ProgressStyle::default_bar())
+            .with_key("work_eta", super::slam_eta::eta_key(super::slam_eta::processed_so_far(&odo, gate))),
     );
     let start = std::time::Instant::now();
     let mut index = 0;

@@ -34,8 +34,7 @@ pub fn run(cmd: WorldCommand) -> Result<ExitCode> {
 }
 
 fn from_map(map: &Path, output: &Path, clearance: f64) -> Result<ExitCode> {
-    super::paths::check_extension(output, "--output", &["toml"])?;
-    super::paths::check_outputs(&[output], &[map])?;
+    super::Outputs::reading([map]).file("--output", output, super::kind::TOML).check()?;
     if !(clearance.is_finite() && clearance > 0.0) {
         bail!("--clearance {clearance}: must be a positive number of metres");
     }

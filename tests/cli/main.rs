@@ -8,6 +8,8 @@ mod map;
 mod merge;
 mod merge_many;
 mod reliability;
+mod reliability_inputs;
+mod reliability_outputs;
 mod run;
 mod sim;
 mod sim_log;

@@ -186,10 +186,14 @@ fn symmetric_building() -> mrslam_core::OccupancyGrid {
 fn correlative_refuses_an_ambiguous_pose_naming_the_rival_unless_the_test_is_off() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    let (a, report) = (d.join("a.yaml"), d.join("r.json"));
+    let (a, b, report) = (d.join("a.yaml"), d.join("b.yaml"), d.join("r.json"));
     write_ros_map(&symmetric_building(), &a).unwrap();
+    // The same building seen from another frame (a map merged with itself is refused).
+    let text_a = std::fs::read_to_string(&a).unwrap();
+    let origin = text_a.lines().find(|l| l.starts_with("origin:")).unwrap();
+    std::fs::write(&b, text_a.replace(origin, "origin: [1.5, -2.0, 0.0]")).unwrap();
     let run = |extra: &[&str]| {
-        let mut args = vec!["merge", p(&a), p(&a), "--algorithm", "correlative", "--report", p(&report)];
+        let mut args = vec!["merge", p(&a), p(&b), "--algorithm", "correlative", "--report", p(&report)];
         args.extend_from_slice(extra);
         let o = mrslam(&args);
         let r: serde_json::Value = serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();

@@ -150,7 +150,11 @@ fn bad_logs_and_parameters_are_refused_and_write_nothing() {
     let o = mrslam(&["log", "info", backwards.to_str().unwrap(), "--max-step-back", "10"]);
     assert!(o.status.success() && text(&o.stdout).contains("1 stamps out of order (max 6.00 s back, line 10)"));
     // Outputs never overwrite inputs; bad relations are refused before the work.
-    refused(&good, &["--trajectory", good.to_str().unwrap()], &["refusing to write an output over the input"]);
+    refused(&good, &["--trajectory", good.to_str().unwrap()], &["--trajectory", "`.clf` is not a format written here"]);
+    let rel = good.with_file_name("rel.txt");
+    std::fs::write(&rel, "").unwrap();
+    let r = rel.to_str().unwrap();
+    refused(&good, &["--relations", r, "--trajectory", r], &["refusing to write an output over the input"]);
     let bad_rel = dir.path().join("bad.relations");
     std::fs::write(&bad_rel, "1 2 0 0 0 0 0 0\n1 2 0 0 0 0 0 zz\n").unwrap();
     refused(&good, &["--relations", bad_rel.to_str().unwrap()], &["bad.relations:2: field yaw: `zz`"]);

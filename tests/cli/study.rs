@@ -116,6 +116,18 @@ fn a_small_study_writes_consistent_results_summary_and_plot_and_shards_agree() {
     let strip_time = |rows: &[Vec<String>]| rows.iter().map(|r| r[..9].to_vec()).collect::<Vec<_>>();
     assert_eq!(strip_time(&csv(&joined.join("summary.csv")).1), strip_time(&summary));
 
+    // Collecting one shard of two is refused, naming the missing one; --partial collects it, saying so.
+    let half = dir.path().join("half");
+    let o = mrslam(&["study", "collect", s0.to_str().unwrap(), "--out", half.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(1));
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(e.contains("shard 1/2 of the study is missing") && e.contains("--partial"), "{e}");
+    assert!(!half.exists(), "nothing written");
+    let o = mrslam(&["study", "collect", s0.to_str().unwrap(), "--out", half.to_str().unwrap(), "--partial"]);
+    ok(&o);
+    assert!(String::from_utf8_lossy(&o.stdout).contains("missing:   shards 1/2"));
+    assert!(!std::fs::read_to_string(half.join("study.json")).unwrap().contains("\"shard\""));
+
     // Collecting a shard twice is refused.
     let o =
         mrslam(&["study", "collect", s0.to_str().unwrap(), s0.to_str().unwrap(), "--out", joined.to_str().unwrap()]);

@@ -69,7 +69,8 @@ pub enum RelationsError {
 }
 
 /// Splits `text` into (line number, fields) of its non-empty, non-comment lines, each parsed as finite
-/// numbers; `names` names the fields for errors, and a line needs at least `names.len()` of them.
+/// numbers; `names` names the fields for errors, and a line has exactly `names.len()` of them (a file of the
+/// other kind, a relations file given as a trajectory, is refused at its first line).
 fn numeric_lines(text: &str, path: &Path, names: &[&str]) -> Result<Vec<(usize, Vec<f64>)>, RelationsError> {
     let mut rows = Vec::new();
     for (i, line) in text.lines().enumerate() {
@@ -79,8 +80,18 @@ fn numeric_lines(text: &str, path: &Path, names: &[&str]) -> Result<Vec<(usize, 
         }
         let bad = |message: String| RelationsError::Line { path: path.to_path_buf(), line: i + 1, message };
         let fields: Vec<&str> = body.split_whitespace().collect();
-        if fields.len() < names.len() {
-            return Err(bad(format!("expected {} fields ({}), found {}", names.len(), names.join(" "), fields.len())));
+        if fields.len() != names.len() {
+            let hint = match fields.len() {
+                8 => ": a relations file (t1 t2 x y z roll pitch yaw)?",
+                4 => ": a trajectory (stamp x y theta)?",
+                _ => "",
+            };
+            return Err(bad(format!(
+                "expected {} fields ({}), found {}{hint}",
+                names.len(),
+                names.join(" "),
+                fields.len()
+            )));
         }
         let mut v = Vec::with_capacity(names.len());
         for (name, f) in names.iter().zip(&fields) {
@@ -306,6 +317,16 @@ mod tests {
         assert!((s.translation.std - (0.02f64).sqrt()).abs() < 1e-12);
         assert!((s.translation.mean_sq - 0.03).abs() < 1e-12);
         assert_eq!(s.worst(1)[0].line, 3);
+    }
+
+    #[test]
+    fn a_relations_file_is_no_trajectory_and_a_trajectory_no_relations_file() {
+        let rels = "# t1 t2 x y z roll pitch yaw\n1.0 2.0 0.5 0 0 0 0 0.1\n";
+        let e = parse_trajectory(rels, Path::new("r.relations")).unwrap_err().to_string();
+        assert!(e.starts_with("r.relations:2: expected 4 fields (stamp x y theta), found 8: a relations file"), "{e}");
+        let e = parse_relations("1.0 0 0 0\n", Path::new("t.txt")).unwrap_err().to_string();
+        assert!(e.starts_with("t.txt:1: expected 8 fields") && e.contains("a trajectory (stamp x y theta)?"), "{e}");
+        assert!(parse_trajectory("1.0 0 0 0 # a comment\n", Path::new("t.txt")).is_ok());
     }
 
     #[test]

@@ -25,7 +25,7 @@ use crate::repair::{self, StampOrder};
 use crate::sensor_log::{OdometryRecord, ScanRecord, SensorLog};
 use crate::source::Source;
 use mrslam_core::{LaserScan, Odometry, pose};
-use std::io::BufRead;
+use std::io::{BufRead, Read};
 use std::path::Path;
 
 /// Laser geometry of the FLASER/RLASER lines, from PARAM lines or defaults.
@@ -49,12 +49,36 @@ pub fn parse(reader: impl BufRead, path: &Path, options: &ReadOptions) -> Result
     let mut front = OldLaser::default();
     let mut rear = OldLaser::default();
     let mut order = StampOrder::new(options);
-    for (i, line) in reader.lines().enumerate() {
-        let line_no = i + 1;
-        let line = line.map_err(|cause| match cause.kind() {
+    // Every read goes through two bounds: the whole log's bytes and each line's, so that a device or a
+    // decompression bomb is refused before it fills memory.
+    let mut reader = reader.take(options.max_bytes.saturating_add(1));
+    let mut bytes = Vec::new();
+    let mut line_no = 0;
+    loop {
+        bytes.clear();
+        let line_limit = (options.max_line_bytes as u64).saturating_add(1);
+        let n = (&mut reader).take(line_limit).read_until(b'\n', &mut bytes).map_err(|cause| match cause.kind() {
             // A gzip stream that ends before its end marker: a truncated file.
-            std::io::ErrorKind::UnexpectedEof => LogError::Truncated { path: path.to_path_buf(), line: i },
+            std::io::ErrorKind::UnexpectedEof => LogError::Truncated { path: path.to_path_buf(), line: line_no },
             _ => LogError::Io { path: path.to_path_buf(), cause },
+        })?;
+        if n == 0 {
+            break;
+        }
+        line_no += 1;
+        if reader.limit() == 0 {
+            return Err(LogError::TooLarge { path: path.to_path_buf(), limit: options.max_bytes, compressed: false });
+        }
+        if n as u64 == line_limit && bytes.last() != Some(&b'\n') {
+            return Err(LogError::LineTooLong {
+                path: path.to_path_buf(),
+                line: line_no,
+                limit: options.max_line_bytes,
+            });
+        }
+        let line = std::str::from_utf8(&bytes).map_err(|e| LogError::Io {
+            path: path.to_path_buf(),
+            cause: std::io::Error::new(std::io::ErrorKind::InvalidData, format!("line {line_no}: not UTF-8 text: {e}")),
         })?;
         let mut fields = line.split_whitespace();
         let Some(kind) = fields.next() else { continue };
@@ -260,6 +284,38 @@ ODOM 0.0 0.0 0.0 0.0 0.0 0.0 1.0 host 1.0
         let rr = &log.scans[2];
         assert_eq!(rr.sensor, "RLASER");
         assert!((Xyt::from_pose(&rr.laser_offset).theta - std::f64::consts::PI).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_line_longer_than_the_bound_is_refused_naming_it() {
+        let opts = ReadOptions { max_line_bytes: 64, ..ReadOptions::default() };
+        let text = format!("# CARMEN\nODOM 0 0 0 0 0 0 1.0 h 1\n{}\n", "9 ".repeat(40));
+        let e = parse(text.as_bytes(), Path::new("l.clf"), &opts).unwrap_err();
+        assert!(matches!(e, LogError::LineTooLong { line: 3, limit: 64, .. }), "{e}");
+        assert!(e.to_string().starts_with("l.clf:3: line longer than 64 bytes"), "{e}");
+        // A line of exactly the bound, newline included, is read; so is a last line without a newline.
+        let exact = format!("{}\n{}", "#".repeat(63), "#".repeat(64));
+        assert_eq!(parse(exact.as_bytes(), Path::new("l.clf"), &opts).unwrap().skipped["comment"], 2);
+        // Bytes that never end a line (an endless device) stop at the bound.
+        let e = parse(std::io::BufReader::new(std::io::repeat(b'x')), Path::new("x.clf"), &opts).unwrap_err();
+        assert!(matches!(e, LogError::LineTooLong { line: 1, .. }), "{e}");
+    }
+
+    #[test]
+    fn a_log_larger_than_the_bound_is_refused() {
+        let line = "ODOM 0 0 0 0 0 0 1.0 h 1\n";
+        let text = line.repeat(100);
+        let opts = ReadOptions { max_bytes: 1000, ..ReadOptions::default() };
+        let e = parse(text.as_bytes(), Path::new("big.clf"), &opts).unwrap_err();
+        assert!(matches!(e, LogError::TooLarge { limit: 1000, compressed: false, .. }), "{e}");
+        assert!(e.to_string().starts_with("big.clf: more than 1000 bytes: refused"), "{e}");
+        // Exactly the bound is read.
+        let exact = ReadOptions { max_bytes: text.len() as u64, ..ReadOptions::default() };
+        assert_eq!(parse(text.as_bytes(), Path::new("big.clf"), &exact).unwrap().odometry.len(), 1);
+        // Endless empty lines (short lines, so the line bound never trips) stop at the total bound.
+        let lines = std::io::BufReader::new(std::io::repeat(b'\n'));
+        let e = parse(lines, Path::new("n.clf"), &ReadOptions { max_bytes: 1 << 20, ..opts }).unwrap_err();
+        assert!(matches!(e, LogError::TooLarge { .. }), "{e}");
     }
 
     #[test]

@@ -34,6 +34,29 @@ pub enum LogError {
         /// What is wrong.
         message: String,
     },
+    /// A line longer than [`ReadOptions::max_line_bytes`](crate::ReadOptions::max_line_bytes): not a text log.
+    #[error("{path}:{line}: line longer than {limit} bytes: not a text log (a device or a binary file?)")]
+    LineTooLong {
+        /// File at fault.
+        path: PathBuf,
+        /// The line's number.
+        line: usize,
+        /// The bound, bytes.
+        limit: usize,
+    },
+    /// More bytes than [`ReadOptions::max_bytes`](crate::ReadOptions::max_bytes), once decompressed.
+    #[error(
+        "{path}: more than {}{}: refused before it exhausts memory (an endless device, or a gzip bomb?)",
+        size_text(*.limit), if *.compressed { " once decompressed" } else { "" }
+    )]
+    TooLarge {
+        /// File at fault.
+        path: PathBuf,
+        /// The bound, bytes.
+        limit: u64,
+        /// Whether the file is gzipped.
+        compressed: bool,
+    },
     /// The file is in no format a reader of this crate knows.
     #[error(
         "{path}: not a log format mrslam reads (expected a CARMEN log: .clf or .log, plain or gzipped, text lines \
@@ -43,4 +66,13 @@ pub enum LogError {
         /// File at fault.
         path: PathBuf,
     },
+}
+
+/// A size as people read it: "2 GiB", "1 MiB", or bytes when it is not a whole number of either.
+fn size_text(bytes: u64) -> String {
+    match bytes {
+        b if b >= 1 << 30 && b % (1 << 30) == 0 => format!("{} GiB", b >> 30),
+        b if b >= 1 << 20 && b % (1 << 20) == 0 => format!("{} MiB", b >> 20),
+        b => format!("{b} bytes"),
+    }
 }

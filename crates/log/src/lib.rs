@@ -28,7 +28,7 @@ mod sensor_log;
 mod source;
 
 pub use error::LogError;
-pub use options::{MAX_STEP_BACK, OdometrySource, ReadOptions};
+pub use options::{MAX_LINE_BYTES, MAX_LOG_BYTES, MAX_STEP_BACK, OdometrySource, ReadOptions};
 pub use read::{Format, format_by_content, format_by_extension, log_name, read_log};
 pub use sensor_log::{OdometryRecord, Repairs, ScanRecord, SensorLog};
 pub use source::{Source, span};

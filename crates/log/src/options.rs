@@ -51,10 +51,24 @@ pub struct ReadOptions {
     /// Seconds by which each scan was taken before its stamp: odometry is interpolated at the stamp minus
     /// this (0: at the stamp). Only with [`OdometrySource::Interpolated`].
     pub scan_latency: f64,
+    /// Longest line a text log may have, bytes ([`MAX_LINE_BYTES`]): a longer one (a device, a binary file)
+    /// is refused before it fills memory.
+    pub max_line_bytes: usize,
+    /// Most bytes a log may hold once decompressed ([`MAX_LOG_BYTES`]): a larger one (an endless device, a
+    /// gzip bomb) is refused when it passes the bound, before it exhausts memory.
+    pub max_bytes: u64,
 }
 
 /// The default bound on stamps stepping back, seconds ([`ReadOptions::max_step_back`]).
 pub const MAX_STEP_BACK: f64 = 5.0;
+
+/// The default longest line of a text log, bytes: 1 MiB ([`ReadOptions::max_line_bytes`]). A CARMEN
+/// ROBOTLASER1 line of a 1081-beam laser with remissions is about 20 KB.
+pub const MAX_LINE_BYTES: usize = 1 << 20;
+
+/// The default bound on a log's decompressed size, bytes: 2 GiB ([`ReadOptions::max_bytes`]). The largest
+/// benchmark logs are under 200 MB.
+pub const MAX_LOG_BYTES: u64 = 2 << 30;
 
 impl Default for ReadOptions {
     fn default() -> Self {
@@ -63,6 +77,8 @@ impl Default for ReadOptions {
             max_step_back: MAX_STEP_BACK,
             repair_reversing: true,
             scan_latency: 0.0,
+            max_line_bytes: MAX_LINE_BYTES,
+            max_bytes: MAX_LOG_BYTES,
         }
     }
 }

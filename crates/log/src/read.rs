@@ -66,9 +66,14 @@ pub fn read_log(path: &Path, options: &ReadOptions) -> Result<SensorLog, LogErro
             format_by_content(head).ok_or_else(|| LogError::UnknownFormat { path: path.to_path_buf() })?
         }
     };
-    match format {
+    let parsed = match format {
         Format::Carmen => carmen::parse(reader, path, options),
-    }
+    };
+    // The readers see bytes, not the file: the bound was passed once decompressed when the file is gzipped.
+    parsed.map_err(|e| match e {
+        LogError::TooLarge { path, limit, .. } => LogError::TooLarge { path, limit, compressed: gzipped },
+        e => e,
+    })
 }
 
 /// The log's name for displays and recordings: its file name without `.gz`, `.clf` and `.log`.
@@ -112,6 +117,42 @@ mod tests {
             assert!(matches!(e, LogError::UnknownFormat { .. }), "{name}: {e}");
             assert!(e.to_string().starts_with(&format!("{}: not a log format", p.display())), "{e}");
         }
+    }
+
+    /// `text` gzipped into `path`.
+    fn gzip(path: &Path, text: &[u8]) {
+        let mut enc = flate2::write::GzEncoder::new(std::fs::File::create(path).unwrap(), flate2::Compression::best());
+        enc.write_all(text).unwrap();
+        enc.finish().unwrap();
+    }
+
+    #[test]
+    fn a_gzip_bomb_is_refused_by_its_decompressed_bytes() {
+        let dir = tempfile::tempdir().unwrap();
+        // 4 MiB of valid lines in about 20 KB: refused past 1 MiB decompressed, not read whole.
+        let p = dir.path().join("bomb.clf.gz");
+        gzip(&p, &LOG.as_bytes().repeat((4 << 20) / LOG.len()));
+        assert!(std::fs::metadata(&p).unwrap().len() < 100_000);
+        let small = ReadOptions { max_bytes: 1 << 20, ..ReadOptions::default() };
+        let e = read_log(&p, &small).unwrap_err();
+        assert!(matches!(e, LogError::TooLarge { limit: 1048576, compressed: true, .. }), "{e}");
+        assert!(e.to_string().contains("more than 1 MiB once decompressed"), "{e}");
+        // One endless line of zeros, gzipped: refused at the line bound.
+        let p = dir.path().join("zeros.clf.gz");
+        gzip(&p, &vec![b'0'; 4 << 20]);
+        let short = ReadOptions { max_line_bytes: 4096, ..ReadOptions::default() };
+        let e = read_log(&p, &short).unwrap_err();
+        assert!(matches!(e, LogError::LineTooLong { line: 1, limit: 4096, .. }), "{e}");
+    }
+
+    #[test]
+    fn an_endless_device_named_as_a_log_is_refused_at_its_first_line() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("zero.clf");
+        std::os::unix::fs::symlink("/dev/zero", &p).unwrap();
+        let e = read_log(&p, &ReadOptions::default()).unwrap_err();
+        assert!(matches!(e, LogError::LineTooLong { line: 1, .. }), "{e}");
+        assert!(e.to_string().contains("zero.clf:1: line longer than 1048576 bytes"), "{e}");
     }
 
     #[test]

@@ -13,6 +13,9 @@ fn carmen_log_corpus() {
         let path = entry.unwrap().path();
         let bytes = std::fs::read(&path).unwrap();
         let _ = carmen::parse(bytes.as_slice(), &path, &ReadOptions::default());
+        // As the fuzz target does: with bounds small enough for the corpus to reach them.
+        let small = ReadOptions { max_line_bytes: 64, max_bytes: 1024, ..ReadOptions::default() };
+        let _ = carmen::parse(bytes.as_slice(), &path, &small);
         files += 1;
     }
     assert!(files > 0, "{}: empty corpus", dir.display());

@@ -30,6 +30,23 @@ pub struct PairSpec {
     pub rotate: bool,
 }
 
+/// The largest shift of a pair's moved half, metres ([`PairSpec::max_shift_m`]).
+pub const MAX_SHIFT_M: f64 = 1000.0;
+
+impl PairSpec {
+    /// Refuses an overlap outside [-0.9, 0.95) and a shift that is not a number of metres in
+    /// 0..=[`MAX_SHIFT_M`], saying which.
+    pub fn validate(&self) -> Result<(), String> {
+        if !(-0.9..0.95).contains(&self.overlap) {
+            return Err(format!("overlap {}: must lie in [-0.9, 0.95)", self.overlap));
+        }
+        if !(0.0..=MAX_SHIFT_M).contains(&self.max_shift_m) {
+            return Err(format!("max shift {} m: must lie in 0..={MAX_SHIFT_M} m", self.max_shift_m));
+        }
+        Ok(())
+    }
+}
+
 impl Default for PairSpec {
     fn default() -> Self {
         PairSpec { overlap: 0.3, max_shift_m: 5.0, rotate: true }
@@ -37,7 +54,8 @@ impl Default for PairSpec {
 }
 
 /// Cuts `map` along a random direction into two halves with the given overlap, then rotates and shifts the
-/// second half at random. Deterministic in `seed`.
+/// second half at random. Deterministic in `seed`. A spec [`PairSpec::validate`] refuses does not panic: a
+/// shift that is not a non-negative number moves nothing.
 pub fn cut_pair(map: &OccupancyGrid, spec: &PairSpec, seed: u64) -> MapPair {
     cut_pair_with(map, spec, seed, |rng| rng.random_range(-std::f64::consts::PI..std::f64::consts::PI))
 }
@@ -92,11 +110,8 @@ fn cut_pair_with(
     let a = keep(&in_a);
     let b_cut = keep(&in_b);
     let theta = if spec.rotate { draw_angle(&mut rng) } else { 0.0 };
-    let t_b_a = pose(
-        rng.random_range(-spec.max_shift_m..=spec.max_shift_m),
-        rng.random_range(-spec.max_shift_m..=spec.max_shift_m),
-        theta,
-    );
+    let s = if spec.max_shift_m.is_finite() { spec.max_shift_m.max(0.0) } else { 0.0 };
+    let t_b_a = pose(rng.random_range(-s..=s), rng.random_range(-s..=s), theta);
     let b = resample(&b_cut, &t_b_a, map.resolution());
     MapPair { a, b, t_a_b: t_b_a.inverse(), overlap: if either == 0 { 0.0 } else { both as f64 / either as f64 } }
 }
@@ -106,6 +121,19 @@ mod tests {
     use super::*;
     use crate::floorplan::{FloorplanParams, generate};
     use crate::verify::agreement;
+
+    #[test]
+    fn a_bad_shift_is_refused_by_validate_and_does_not_panic() {
+        let map = generate(3, &FloorplanParams::default());
+        for shift in [-5.0, f64::NAN, 1e9] {
+            let spec = PairSpec { max_shift_m: shift, ..PairSpec::default() };
+            assert!(spec.validate().unwrap_err().contains("max shift"), "{shift}");
+            let pair = cut_pair(&map, &spec, 1);
+            assert!(pair.t_a_b.translation.vector.norm() < 1e9, "{shift}");
+        }
+        assert!(PairSpec { overlap: 0.99, ..PairSpec::default() }.validate().unwrap_err().contains("overlap"));
+        assert_eq!(PairSpec::default().validate(), Ok(()));
+    }
 
     #[test]
     fn overlap_is_as_asked_and_truth_aligns_the_halves() {

@@ -10,8 +10,7 @@ export CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-$root/target}"
 dir="$(mktemp -d)"
 (cd "$root" && cargo build -q --release -p mrslam-dev --bin gen_images --bin sift_json)
 "$CARGO_TARGET_DIR/release/gen_images" "$dir" > /dev/null
-tool="$root/../shared/tools/opencv_sift.py"
-[ -f "$tool" ] || { echo "opencv_sift.py not found beside the repository (../shared/tools)" >&2; exit 1; }
+tool="$root/dev/scripts/opencv_sift.py"
 for img in map_1024 texture_1024; do
   ours=(); cv=()
   for _ in $(seq "$rounds"); do

@@ -9,7 +9,6 @@ root="$(cd "$here/../../.." && pwd)"
 out="$(mktemp -d)"
 export CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-$root/target}"
 (cd "$root" && cargo run -q --release -p mrslam-dev --bin sift_json -- "$img" "$out/ours.json" --runs "$runs")
-tool="$root/../shared/tools/opencv_sift.py"
-[ -f "$tool" ] || { echo "opencv_sift.py not found beside the repository (../shared/tools)" >&2; exit 1; }
+tool="$root/dev/scripts/opencv_sift.py"
 python3 "$tool" "$img" --runs "$runs" --json "$out/opencv.json"
 python3 "$here/compare_opencv.py" "$out/ours.json" "$out/opencv.json"

@@ -81,12 +81,31 @@ impl StudyParams {
     }
 }
 
-/// The parameters of the study whose shards `dirs` hold: refuses shards of different studies, and a mix of
-/// shards with and without `study.json`; `None` when no shard has one (folders of an older mrslam).
-pub fn collect_params(dirs: &[PathBuf]) -> Result<Option<StudyParams>, StudyError> {
+/// The parameter naming a shard of a study split across processes (`K/N`, 0-based): set only for N > 1, and
+/// the one parameter in which the shards of one study differ.
+pub const SHARD_PARAM: &str = "shard";
+
+/// The shards of `count` that `found` (their 0-based indices) lacks.
+fn missing_shards(found: &BTreeSet<usize>, count: usize) -> Vec<usize> {
+    (0..count).filter(|k| !found.contains(k)).collect()
+}
+
+/// The parameters of the study whose shards `dirs` hold (the shard aside): refuses shards of different
+/// studies, a mix of shards with and without `study.json`, and, unless `partial`, an incomplete set of shards
+/// (each names its shard in `study.json`). Returns the parameters (`None` when no shard has a `study.json`:
+/// folders of an older mrslam) and the missing shards' names (`K/N`, empty when all are there).
+pub fn collect_params(dirs: &[PathBuf], partial: bool) -> Result<(Option<StudyParams>, Vec<String>), StudyError> {
     let mut first: Option<(&PathBuf, Option<StudyParams>)> = None;
+    let mut shards: BTreeMap<usize, BTreeSet<usize>> = BTreeMap::new();
     for d in dirs {
-        let p = StudyParams::read(d)?;
+        let mut p = StudyParams::read(d)?;
+        if let Some(shard) = p.as_mut().and_then(|p| p.0.remove(SHARD_PARAM)) {
+            let s = crate::Shard::parse(&shard).map_err(|e| StudyError::File {
+                path: d.join(PARAMS_FILE),
+                message: format!("`{SHARD_PARAM}`: {e}"),
+            })?;
+            shards.entry(s.count).or_default().insert(s.index);
+        }
         match &first {
             None => first = Some((d, p)),
             Some((d0, p0)) => match (p0, &p) {
@@ -107,7 +126,27 @@ pub fn collect_params(dirs: &[PathBuf]) -> Result<Option<StudyParams>, StudyErro
             },
         }
     }
-    Ok(first.and_then(|(_, p)| p))
+    if shards.len() > 1 {
+        let counts: Vec<String> = shards.keys().map(usize::to_string).collect();
+        return Err(StudyError::Invalid(format!(
+            "collect: the folders are shards of studies split {} ways: not one study",
+            counts.join(" and ")
+        )));
+    }
+    let missing: Vec<String> = shards
+        .iter()
+        .flat_map(|(&n, found)| missing_shards(found, n).into_iter().map(move |k| format!("{k}/{n}")))
+        .collect();
+    if !missing.is_empty() && !partial {
+        return Err(StudyError::Invalid(format!(
+            "collect: shard{} {} of the study {} missing (not among the folders given); give every shard's \
+             folder, or --partial to collect these anyway",
+            if missing.len() > 1 { "s" } else { "" },
+            missing.join(", "),
+            if missing.len() > 1 { "are" } else { "is" }
+        )));
+    }
+    Ok((first.and_then(|(_, p)| p), missing))
 }
 
 /// The `results.csv` of a running study, appended to trial by trial.
@@ -213,6 +252,30 @@ fn complete_trials(text: &str, path: &Path, rows_per_trial: usize) -> Result<Vec
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn collecting_some_shards_of_a_study_is_refused_naming_the_missing_ones() {
+        let dir = tempfile::tempdir().unwrap();
+        let shard = |k: usize, n: usize| {
+            let d = dir.path().join(format!("s{k}of{n}"));
+            std::fs::create_dir_all(&d).unwrap();
+            let mut p = StudyParams::default();
+            p.set("kind", "overlap").set(SHARD_PARAM, format!("{k}/{n}"));
+            p.write(&d).unwrap();
+            d
+        };
+        let (a, c) = (shard(0, 3), shard(2, 3));
+        let e = collect_params(&[a.clone(), c.clone()], false).unwrap_err().to_string();
+        assert!(e.contains("shard 1/3 of the study is missing") && e.contains("--partial"), "{e}");
+        let (params, missing) = collect_params(&[a.clone(), c.clone()], true).unwrap();
+        assert_eq!(missing, vec!["1/3".to_string()]);
+        // The collected study is the whole one: no shard named.
+        assert_eq!(params.unwrap().0.get(SHARD_PARAM), None);
+        let (_, missing) = collect_params(&[a.clone(), shard(1, 3), c], false).unwrap();
+        assert!(missing.is_empty());
+        let e = collect_params(&[a, shard(1, 2)], true).unwrap_err().to_string();
+        assert!(e.contains("split 2 and 3 ways"), "{e}");
+    }
 
     fn row(trial: usize, alg: &str) -> TrialRow {
         TrialRow {

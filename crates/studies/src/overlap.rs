@@ -105,6 +105,13 @@ impl OverlapStudy {
         if !(self.max_rotation_deg >= 0.0 && self.max_translation_cells >= 0.0 && self.max_shift_m >= 0.0) {
             return bad("success thresholds and the shift must not be negative".into());
         }
+        if self.max_shift_m > mrslam_merge::pairs::MAX_SHIFT_M {
+            return bad(format!(
+                "--max-shift {}: must be at most {} m",
+                self.max_shift_m,
+                mrslam_merge::pairs::MAX_SHIFT_M
+            ));
+        }
         Ok(())
     }
 

@@ -17,6 +17,10 @@ pub struct CollectArgs {
     /// Output folder of the joined study.
     #[arg(long)]
     pub out: PathBuf,
+    /// Collect the shards given although some of the study's are missing (each shard's study.json names its
+    /// shard K/N); by default a missing shard is an error.
+    #[arg(long)]
+    pub partial: bool,
 }
 
 /// Runs `mrslam study collect`.
@@ -26,8 +30,9 @@ pub(super) fn run(a: CollectArgs) -> Result<ExitCode> {
             bail!("--out {}: is one of the shard folders; its results.csv would be overwritten", a.out.display());
         }
     }
-    let params = collect_params(&a.dirs)?;
+    // A trial found twice (a shard given twice) first, then shards of other studies or missing ones.
     let rows = collect(&a.dirs)?;
+    let (params, missing) = collect_params(&a.dirs, a.partial)?;
     create_out(&a.out)?;
     if let Some(p) = &params {
         p.write(&a.out)?;
@@ -35,5 +40,8 @@ pub(super) fn run(a: CollectArgs) -> Result<ExitCode> {
     let mut trials: Vec<usize> = rows.iter().map(|r| r.trial).collect();
     trials.dedup();
     println!("collected {} rows ({} trials) from {} shard folders", rows.len(), trials.len(), a.dirs.len());
+    if !missing.is_empty() {
+        println!("missing:   shards {} (--partial: the summary covers only the trials collected)", missing.join(", "));
+    }
     finish(&rows, &a.out, trials.len(), None)
 }

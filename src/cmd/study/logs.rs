@@ -112,17 +112,14 @@ pub(super) fn run(a: LogsArgs) -> Result<ExitCode> {
     if a.out.is_file() {
         bail!("--out {}: is a file, expected a folder", a.out.display());
     }
-    let inputs = [a.log.as_path(), a.relations.as_path()];
-    let mut outputs: Vec<PathBuf> =
-        ["study.json", "results.csv", "summary.csv", "plot.png", "parts.csv"].iter().map(|f| a.out.join(f)).collect();
+    let mut more = vec![a.out.join("parts.csv")];
     for k in 0..a.parts {
         let (map, traj) = part_files(&a.out, k);
-        outputs.extend([map, traj]);
+        more.extend([map, traj]);
     }
+    let outputs = super::study_outputs(&a.out, [a.log.as_path(), a.relations.as_path()], &more);
     if a.out.is_dir() {
-        for o in &outputs {
-            crate::cmd::check_not_input(o, &inputs)?;
-        }
+        outputs.check()?;
     }
     // The relations before the log: a bad file costs nothing.
     let rels = relations::read_relations(&a.relations)?;
@@ -154,9 +151,7 @@ pub(super) fn run(a: LogsArgs) -> Result<ExitCode> {
         params.set("drift", a.drift.describe());
     }
     create_out(&a.out)?;
-    for o in &outputs {
-        crate::cmd::check_not_input(o, &inputs)?;
-    }
+    outputs.check()?;
     if a.resume {
         let found = StudyParams::read(&a.out)?.with_context(|| {
             format!("{}: nothing to resume: no study was started in this folder", a.out.join("study.json").display())

@@ -8,7 +8,8 @@ mod logs;
 mod overlap;
 mod scenario;
 
-use anyhow::{Context, Result};
+use crate::cmd::{Outputs, kind};
+use anyhow::{Context, Result, bail};
 use clap::Subcommand;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use mrslam_studies::journal::{Journal, StudyParams};
@@ -17,7 +18,7 @@ use mrslam_studies::summary::table;
 use mrslam_studies::{self as study, Progress, Shard, StudyError};
 use std::collections::BTreeSet;
 use std::io::IsTerminal;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
 
@@ -52,18 +53,41 @@ pub(super) fn shard_of(arg: Option<&str>) -> Result<Shard> {
     })
 }
 
+/// Names the shard in a sharded study's parameters, so that `collect` can tell when one is missing.
+pub(super) fn name_shard(params: &mut StudyParams, shard: Shard) {
+    if shard.count > 1 {
+        params.set(mrslam_studies::journal::SHARD_PARAM, format!("{}/{}", shard.index, shard.count));
+    }
+}
+
 pub(super) fn progress_bar(len: usize, quiet: bool, what: &str) -> ProgressBar {
     let bar = ProgressBar::new(len as u64);
     if quiet || !std::io::stderr().is_terminal() {
         bar.set_draw_target(ProgressDrawTarget::hidden());
     }
     bar.set_style(
-        ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} trials, {per_sec}, {elapsed} elapsed, ETA {eta}")
+        ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} trials, {rate}, {elapsed} elapsed, ETA {eta}")
             .expect("valid template")
+            .with_key("rate", |s: &indicatif::ProgressState, w: &mut dyn std::fmt::Write| {
+                let _ = w.write_str(&rate_text(s.per_sec()));
+            })
             .progress_chars("=> "),
     );
     bar.set_message(what.to_string());
     bar
+}
+
+/// A rate of trials as people read it: three significant figures, per minute when under one a second.
+fn rate_text(per_sec: f64) -> String {
+    let (rate, unit) = if per_sec < 1.0 { (per_sec * 60.0, "min") } else { (per_sec, "s") };
+    let decimals = if rate >= 100.0 {
+        0
+    } else if rate >= 10.0 {
+        1
+    } else {
+        2
+    };
+    format!("{rate:.decimals$}/{unit}")
 }
 
 pub(super) fn create_out(dir: &Path) -> Result<()> {
@@ -91,13 +115,39 @@ impl Progress for Recorder {
 }
 
 /// Opens the study folder (fresh or resumed) and says what a resume found.
-pub(super) fn open_study(
+/// The files every study writes in its folder, and their kinds.
+const STUDY_FILES: [(&str, &[&str]); 4] =
+    [("study.json", kind::JSON), ("results.csv", kind::CSV), ("summary.csv", kind::CSV), ("plot.png", kind::PNG)];
+
+/// A study's outputs in `out` (the files every study writes, then `more`), for the one output rule.
+pub(super) fn study_outputs<'p>(out: &Path, inputs: impl IntoIterator<Item = &'p Path>, more: &[PathBuf]) -> Outputs {
+    let mut rule = Outputs::reading(inputs);
+    for (name, k) in STUDY_FILES {
+        rule = rule.file("--out", &out.join(name), k);
+    }
+    for m in more {
+        rule = rule.file("--out", m, kind::ANY);
+    }
+    rule
+}
+
+/// Creates the study folder `out` (its outputs checked against `inputs` first) and opens its journal.
+pub(super) fn open_study<'p>(
     out: &Path,
+    inputs: impl IntoIterator<Item = &'p Path>,
     params: &StudyParams,
     rows_per_trial: usize,
     resume: bool,
 ) -> Result<(Journal, Vec<TrialRow>)> {
+    if out.is_file() {
+        bail!("--out {}: is a file, expected a folder", out.display());
+    }
+    let rule = study_outputs(out, inputs, &[]);
+    if out.is_dir() {
+        rule.check()?;
+    }
     create_out(out)?;
+    rule.check()?;
     let (journal, earlier) = Journal::open(out, params, rows_per_trial, resume)?;
     if resume {
         let trials: BTreeSet<usize> = earlier.iter().map(|r| r.trial).collect();
@@ -137,4 +187,17 @@ pub(super) fn finish(rows: &[TrialRow], out: &Path, trials: usize, seconds: Opti
     }
     println!("outputs:  {} (study.json, results.csv, summary.csv, plot.png)", out.display());
     Ok(ExitCode::SUCCESS)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_rate_shows_three_significant_figures() {
+        assert_eq!(rate_text(15.2117), "15.2/s");
+        assert_eq!(rate_text(152.117), "152/s");
+        assert_eq!(rate_text(2.5), "2.50/s");
+        assert_eq!(rate_text(0.05), "3.00/min");
+    }
 }

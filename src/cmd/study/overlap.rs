@@ -41,7 +41,7 @@ pub struct OverlapArgs {
     /// Algorithms, comma-separated (sift, rmap, correlative, cascade); the default compares the paper's two.
     #[arg(long, default_value = "sift,rmap", value_delimiter = ',')]
     pub algorithms: Vec<String>,
-    /// Output folder: results.csv, summary.csv, plot.png.
+    /// Output folder: study.json, results.csv, summary.csv, plot.png.
     #[arg(long)]
     pub out: PathBuf,
     /// Run only shard K of N (trial index mod N = K); default from SLURM_ARRAY_TASK_ID/SLURM_ARRAY_TASK_COUNT.
@@ -93,6 +93,7 @@ pub(super) fn run(a: OverlapArgs) -> Result<ExitCode> {
     }
     let mut params = StudyParams::default();
     params.set("kind", "overlap");
+    super::name_shard(&mut params, shard);
     let source = if let Some(path) = &a.map {
         let grid = crate::cmd::map::read_yaml_map(path).with_context(|| format!("--map {}", path.display()))?;
         params.set("map", fingerprint(&grid_bytes(&grid)));
@@ -135,7 +136,8 @@ pub(super) fn run(a: OverlapArgs) -> Result<ExitCode> {
         .set("max_shift", a.max_shift)
         .set("map_style", &a.map_style)
         .set("encoding", a.encoding);
-    let (journal, earlier) = open_study(&a.out, &params, algorithms.len(), a.resume)?;
+    let inputs = a.map.iter().chain(&a.world).map(PathBuf::as_path);
+    let (journal, earlier) = open_study(&a.out, inputs, &params, algorithms.len(), a.resume)?;
     let selected: Vec<usize> = study.selected_trials().iter().map(|t| t.trial).collect();
     let (rows, n, seconds) = run_study(earlier, journal, &selected, &algorithms, a.quiet, "overlap study", |p| {
         run_overlap_study(&study, p)

@@ -13,7 +13,7 @@ use std::process::ExitCode;
 pub struct ScenarioArgs {
     /// Sweep file (TOML), e.g. scenarios/corridor_sweep.toml.
     pub sweep: PathBuf,
-    /// Output folder: results.csv, summary.csv, plot.png.
+    /// Output folder: study.json, results.csv, summary.csv, plot.png.
     #[arg(long)]
     pub out: PathBuf,
     /// Run only shard K of N (trial index mod N = K); default from SLURM_ARRAY_TASK_ID/SLURM_ARRAY_TASK_COUNT.
@@ -54,6 +54,7 @@ pub(super) fn run(a: ScenarioArgs) -> Result<ExitCode> {
     }
     let mut params = StudyParams::default();
     params.set("kind", "scenario");
+    super::name_shard(&mut params, shard);
     for (name, path) in
         [("sweep", &sweep.path), ("scenario", &sweep.scenario.path), ("world", &sweep.scenario.world_path)]
     {
@@ -66,7 +67,8 @@ pub(super) fn run(a: ScenarioArgs) -> Result<ExitCode> {
     let algorithms: Vec<String> = sweep.algorithms.iter().map(|x| x.name().to_string()).collect();
     params.set("algorithms", algorithms.join(","));
     params.set("seeds", sweep.seeds.iter().map(u64::to_string).collect::<Vec<_>>().join(","));
-    let (journal, earlier) = open_study(&a.out, &params, algorithms.len(), a.resume)?;
+    let inputs = [sweep.path.as_path(), sweep.scenario.path.as_path(), sweep.scenario.world_path.as_path()];
+    let (journal, earlier) = open_study(&a.out, inputs, &params, algorithms.len(), a.resume)?;
     let selected: Vec<usize> = (0..sweep.trials()).filter(|t| shard.selects(*t)).collect();
     let (rows, n, seconds) = run_study(earlier, journal, &selected, &algorithms, a.quiet, &sweep.scenario.name, |p| {
         run_sweep(&sweep, shard, p)

@@ -3,6 +3,7 @@
 
 use super::error::{MapIoError, io_err};
 use crate::grid::MAX_CELLS;
+use std::io::Read as _;
 use std::path::Path;
 
 /// A grey image with 8-bit pixels, row 0 at the top, as stored on disk.
@@ -16,11 +17,49 @@ pub struct GreyImage {
     pub pixels: Vec<u8>,
 }
 
+/// Most bytes read of a map's image: 1 GiB (a 16-bit PGM of [`MAX_CELLS`] pixels is 800 MB; a PNG is smaller).
+pub const IMAGE_LIMIT: u64 = 1 << 30;
+
+/// Bytes that tell an image's format: PGM's `P5`/`P2`, PNG's 8-byte signature, other formats' magic.
+const MAGIC_BYTES: u64 = 16;
+
 /// Reads a grey image: PGM (P5 binary or P2 ASCII, any maxval) by our own parser, anything else (PNG) with
 /// the `image` crate. Colour images are averaged to grey as map_server does; dimensions are checked
-/// against [`MAX_CELLS`] before pixels are allocated.
+/// against [`MAX_CELLS`] before pixels are allocated; at most [`IMAGE_LIMIT`] bytes are read
+/// ([`read_grey_image_limited`]).
 pub fn read_grey_image(path: &Path) -> Result<GreyImage, MapIoError> {
-    let bytes = crate::input::read_limited(path, crate::input::DATA_LIMIT).map_err(io_err(path))?;
+    read_grey_image_limited(path, IMAGE_LIMIT)
+}
+
+/// [`read_grey_image`] reading at most `limit` bytes. The file's first bytes must name an image format (a
+/// device such as `/dev/zero` or a text file is refused having read 16 bytes) and a file whose size exceeds
+/// `limit` is refused before it is read.
+pub fn read_grey_image_limited(path: &Path, limit: u64) -> Result<GreyImage, MapIoError> {
+    let file = std::fs::File::open(path).map_err(io_err(path))?;
+    let len = file.metadata().map_err(io_err(path))?.len();
+    let mut reader = file.take(limit.saturating_add(1));
+    let mut bytes = Vec::new();
+    (&mut reader).take(MAGIC_BYTES).read_to_end(&mut bytes).map_err(io_err(path))?;
+    if bytes.first() != Some(&b'P') && image::guess_format(&bytes).is_err() {
+        return Err(MapIoError::Image {
+            path: path.to_path_buf(),
+            message: "its first bytes are no PGM (P5, P2) or PNG header (a device, or not an image?)".into(),
+        });
+    }
+    let too_large = || {
+        io_err(path)(std::io::Error::new(
+            std::io::ErrorKind::FileTooLarge,
+            format!("larger than the {limit} bytes a map image may have"),
+        ))
+    };
+    if len > limit {
+        return Err(too_large());
+    }
+    bytes.reserve(len.saturating_sub(MAGIC_BYTES) as usize);
+    reader.read_to_end(&mut bytes).map_err(io_err(path))?;
+    if bytes.len() as u64 > limit {
+        return Err(too_large());
+    }
     decode_grey_image(&bytes, path)
 }
 
@@ -171,6 +210,23 @@ mod tests {
         write(dir.path(), "huge.pgm", b"P5\n1000000 1000000\n255\n\0");
         let e = read_grey_image(&dir.path().join("huge.pgm")).unwrap_err();
         assert!(matches!(e, MapIoError::TooLarge { width: 1_000_000, .. }), "{e}");
+    }
+
+    #[test]
+    fn a_device_or_an_oversized_image_is_refused_before_it_is_read() {
+        // /dev/zero: its first bytes are no image header (before: 2 GiB read, then refused).
+        let e = read_grey_image(Path::new("/dev/zero")).unwrap_err().to_string();
+        assert!(e.starts_with("/dev/zero: cannot decode image: its first bytes are no PGM"), "{e}");
+        // A text file is no image either.
+        let dir = tempfile::tempdir().unwrap();
+        let notes = write(dir.path(), "notes.png", b"some words about the map\n");
+        assert!(read_grey_image(&notes).unwrap_err().to_string().contains("its first bytes are no PGM"));
+        // A file larger than the bound is refused by its size; at the bound it is read.
+        let img = [b"P5\n100 100\n255\n".as_slice(), &[0u8; 10_000]].concat();
+        let big = write(dir.path(), "big.pgm", &img);
+        let e = read_grey_image_limited(&big, 4096).unwrap_err().to_string();
+        assert!(e.contains("big.pgm") && e.contains("larger than the 4096 bytes a map image may have"), "{e}");
+        assert_eq!(read_grey_image_limited(&big, img.len() as u64).unwrap().pixels.len(), 10_000);
     }
 
     #[test]

@@ -21,7 +21,10 @@ mod yaml;
 pub use crate::grid::ROS_LOGODDS_LIMIT;
 pub use cells::{PGM_FREE, PGM_OCCUPIED, PGM_UNKNOWN, grid_from_image, grid_to_image, ros_to_log_odds};
 pub use error::MapIoError;
-pub use grey_image::{GreyImage, decode_grey_image, encode_pgm, encode_png, parse_pgm, read_grey_image};
+pub use grey_image::{
+    GreyImage, IMAGE_LIMIT, decode_grey_image, encode_pgm, encode_png, parse_pgm, read_grey_image,
+    read_grey_image_limited,
+};
 pub use preview::{
     OverlayLayer, overlay, preview_image, preview_path, preview_with_path, write_map_preview, write_rgb_png,
 };

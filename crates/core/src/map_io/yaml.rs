@@ -37,6 +37,12 @@ pub struct MapYaml {
     pub mode: MapMode,
 }
 
+/// The coarsest map resolution read, metres per pixel: a pixel larger than a building is a typo.
+pub const MAX_RESOLUTION: f64 = 100.0;
+
+/// The largest origin coordinate read, metres (ten thousand kilometres).
+pub const MAX_COORDINATE: f64 = 1e7;
+
 /// The keys map_server reads from a map YAML.
 pub const MAP_YAML_KEYS: &[&str] =
     &["image", "resolution", "origin", "negate", "occupied_thresh", "free_thresh", "mode"];
@@ -132,8 +138,11 @@ pub fn parse_map_yaml_with(text: &str, path: &Path, warn: &mut dyn FnMut(String)
             }
             "resolution" => {
                 let r = number("resolution")?;
-                if r <= 0.0 {
-                    return Err(bad("resolution", format!("must be positive, found {r}")));
+                if !(r > 0.0 && r <= MAX_RESOLUTION) {
+                    return Err(bad(
+                        "resolution",
+                        format!("must be positive and at most {MAX_RESOLUTION} metres per pixel, found {}", shown()),
+                    ));
                 }
                 resolution = Some(r);
             }
@@ -153,6 +162,9 @@ pub fn parse_map_yaml_with(text: &str, path: &Path, warn: &mut dyn FnMut(String)
                         .ok()
                         .filter(|v| v.is_finite())
                         .ok_or_else(|| bad("origin", format!("`{t}` is not a finite number")))?;
+                    if slot.abs() > MAX_COORDINATE {
+                        return Err(bad("origin", format!("{t}: further than {MAX_COORDINATE:e} m from 0")));
+                    }
                 }
                 origin = Some(o);
             }
@@ -224,6 +236,15 @@ mod tests {
 
     fn yaml(text: &str) -> Result<MapYaml, MapIoError> {
         parse_map_yaml(text, Path::new("m.yaml"))
+    }
+
+    #[test]
+    fn absurd_scales_are_refused() {
+        let e = yaml("image: m.pgm\nresolution: 1e300\norigin: [0, 0, 0]\n").unwrap_err().to_string();
+        assert!(e.contains("m.yaml:2") && e.contains("at most 100 metres per pixel, found 1e300"), "{e}");
+        let e = yaml("image: m.pgm\nresolution: 0.05\norigin: [1e300, 0, 0]\n").unwrap_err().to_string();
+        assert!(e.contains("m.yaml:3") && e.contains("further than 1e7 m"), "{e}");
+        assert!(yaml("image: m.pgm\nresolution: 100\norigin: [-1e7, 0, 0]\n").is_ok());
     }
 
     #[test]

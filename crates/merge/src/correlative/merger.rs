@@ -54,6 +54,12 @@ fn cross_check_refusal(
     }
 }
 
+/// The area a map knows (free or occupied), m².
+fn known_area(g: &OccupancyGrid) -> f64 {
+    let (free, occupied, _) = g.state_counts();
+    (free + occupied) as f64 * g.resolution() * g.resolution()
+}
+
 impl CorrelativeMerger {
     /// The poses that pass the significance test and the shared-area check, best first, and b's wall points (b's
     /// frame, thinned) that weigh them; else why none does.
@@ -74,18 +80,27 @@ impl CorrelativeMerger {
         let (poses, tried) = self.shared(a, b, &refined, min_overlap_m2);
         timings.insert("overlap".into(), ms(t));
         if poses.is_empty() {
-            return Err(NoAnswer::Unsettled(fail(
+            let smaller = known_area(a).min(known_area(b));
+            let reason = if smaller < min_overlap_m2 {
                 format!(
-                    "no pose {}both shares {:.1} m² of known space and has an acceptance index of {:.2}: the {} \
-                     best share {}",
-                    if p.answer.min_margin > 0.0 { "(the best, as the significance test asks) " } else { "" },
-                    min_overlap_m2,
+                    "the correlative stage accepts a pose only where the maps share {min_overlap_m2:.1} m² of known \
+                     space, and the smaller map knows {smaller:.1} m² in all: it cannot accept on maps this small"
+                )
+            } else {
+                format!(
+                    "no pose shares {min_overlap_m2:.1} m² of known space with an acceptance index of {:.2} or more{}: \
+                     the {} tried share {}",
                     p.answer.min_acceptance,
+                    if p.answer.min_margin > 0.0 {
+                        " (the significance test lets only the best pose be tried)"
+                    } else {
+                        ""
+                    },
                     tried.len(),
                     tried.join(", ")
-                ),
-                std::mem::take(timings),
-            )));
+                )
+            };
+            return Err(NoAnswer::Unsettled(fail(reason, std::mem::take(timings))));
         }
         Ok((poses, scan_points))
     }

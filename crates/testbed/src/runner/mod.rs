@@ -14,7 +14,7 @@ mod outputs;
 mod record;
 
 pub use options::{RobotStep, RunError, RunOptions, RunOutput, StepTap};
-pub use outputs::{merge_overlay, write_outputs};
+pub use outputs::{merge_overlay, output_files, write_outputs};
 pub use record::merge_view;
 
 use crate::report::RunReport;

@@ -1,9 +1,11 @@
 //! A run's files: maps, the truth, merged maps with their pictures, and the report.
 
 use super::options::{RunError, RunOutput};
+use crate::scenario::Scenario;
 use mrslam_core::Pose2;
 use mrslam_core::map_io::{self, MapIoError};
-use std::path::Path;
+use mrslam_merge::Algorithm;
+use std::path::{Path, PathBuf};
 
 /// The picture of a merge: the true map in grey, the host robot's map (blue) at its true frame, the other's
 /// (orange) placed by the merge's estimate `t_a_b` from there, each with its SLAM path: where the estimate is
@@ -25,6 +27,27 @@ pub fn merge_overlay(out: &RunOutput, t_a_b: &Pose2) -> image::RgbImage {
             .flatten()
             .collect();
     map_io::overlay(&out.truth, &layers)
+}
+
+/// The files [`write_outputs`] may write into `dir` for `scenario` merged by `algorithms` (`None`: the
+/// scenario's): each robot's map, the truth, each algorithm's merged map (each map's YAML, then its PGM and PNG
+/// preview) and overlay picture, `report.json` last. A caller checks them against its inputs before a run.
+pub fn output_files(scenario: &Scenario, algorithms: Option<&[Algorithm]>, dir: &Path) -> Vec<PathBuf> {
+    let algorithms = algorithms.unwrap_or(&scenario.merge.algorithms);
+    let maps = scenario
+        .robots
+        .iter()
+        .map(|r| r.name.clone())
+        .chain(["truth".to_string()])
+        .chain(algorithms.iter().map(|a| format!("merged_{a}")));
+    let mut files = Vec::new();
+    for name in maps {
+        let yaml = dir.join(format!("{name}.yaml"));
+        files.extend([yaml.clone(), yaml.with_extension("pgm"), map_io::preview_path(&yaml)]);
+    }
+    files.extend(algorithms.iter().map(|a| dir.join(format!("overlay_{a}.png"))));
+    files.push(dir.join("report.json"));
+    files
 }
 
 /// Writes a run's maps (YAML+PGM, each with a PNG preview), the true map, merged maps with a picture of each

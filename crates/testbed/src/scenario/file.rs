@@ -21,20 +21,23 @@ pub(super) struct ScenarioFile {
     pub(super) success: SuccessFile,
 }
 
-/// A pose: a named point of the world or `[x, y, theta]`.
+/// A pose: a named point of the world, `[x, y, theta]` or a table `{ x, y, theta }` as world files write
+/// their named points (theta in radians, default 0).
 #[derive(Deserialize)]
-#[serde(untagged)]
+#[serde(untagged, expecting = "a pose: a named point of the world, [x, y, theta] or { x = .., y = .., theta = .. }")]
 pub(super) enum PoseRef {
     Named(String),
     Xyt([f64; 3]),
+    Table(mrslam_sim::NamedPoint),
 }
 
-/// A point: a named point of the world or `[x, y]`.
+/// A point: a named point of the world, `[x, y]` or a table `{ x, y }` (a `theta` is allowed and ignored).
 #[derive(Deserialize)]
-#[serde(untagged)]
+#[serde(untagged, expecting = "a point: a named point of the world, [x, y] or { x = .., y = .. }")]
 pub(super) enum PointRef {
     Named(String),
     Xy([f64; 2]),
+    Table(mrslam_sim::NamedPoint),
 }
 
 /// A lidar: a preset's name or a table.

@@ -222,6 +222,28 @@ mod tests {
     }
 
     #[test]
+    fn a_pose_or_a_point_may_be_a_table_as_world_files_write_them() {
+        let named = two_rooms(|t| t).unwrap();
+        let s = two_rooms(|t| {
+            t.replacen("start = \"start_prawn\"", "start = { x = 9.0, y = 2.2, theta = 3.14159265 }", 1).replacen(
+                "[9.4, 2.0]",
+                "{ x = 9.4, y = 2.0 }",
+                1,
+            )
+        })
+        .unwrap();
+        assert_eq!(s.robots[1].start, named.robots[1].start);
+        assert_eq!(s.robots[1].route, named.robots[1].route);
+        // Anything else is refused saying what a pose may be.
+        let (e, line) = second_robot("start = \"start_prawn\"", "start = { x = 9.0, north = 2.2 }");
+        assert_eq!(e.line, line, "{e}");
+        assert!(
+            e.message.contains("a named point of the world, [x, y, theta] or { x = .., y = .., theta = .. }"),
+            "{e}"
+        );
+    }
+
+    #[test]
     fn starts_outside_the_world_or_on_the_other_robot_are_refused() {
         let (e, line) = second_robot("start = \"start_prawn\"", "start = [-20.0, 2.5, 0.0]");
         assert_eq!((e.field.as_str(), e.line), ("robots[1].start", line), "{e}");

@@ -51,6 +51,7 @@ pub(super) fn resolve_pose(cx: &Ctx, field: &str, r: &PoseRef, world: &WorldSpec
             world.named_pose(n).ok_or_else(|| cx.err(field, format!("no point named `{n}` in the world")))
         }
         PoseRef::Xyt([x, y, t]) => Ok(pose(*x, *y, *t)),
+        PoseRef::Table(p) => Ok(p.pose()),
     }
 }
 
@@ -124,6 +125,7 @@ pub(super) fn resolve_robot(
                 Point2::new(p.translation.x, p.translation.y)
             }
             PointRef::Xy([x, y]) => Point2::new(*x, *y),
+            PointRef::Table(p) => Point2::new(p.x, p.y),
         };
         if outside(&p) {
             return Err(cx.err(&field, format!("waypoint ({:.2}, {:.2}) lies outside the world ({bounds})", p.x, p.y)));
