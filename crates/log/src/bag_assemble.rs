@@ -88,10 +88,9 @@ fn odometry(bag: &BagMessages, options: &ReadOptions) -> Result<(Vec<Reading>, S
     };
     let to_base: Vec<&Arrived<_>> = bag.transforms.iter().filter(|a| a.msg.child == base).collect();
     let Some(first) = to_base.first() else {
-        return Err(bag.error(format!(
-            "no odometry: no nav_msgs/Odometry topic and no /tf transform to the base frame {base} (topics: {})",
-            all_topics(bag)
-        )));
+        return Err(
+            bag.error(format!("no odometry: no /tf transform to the base frame {base} (topics: {})", all_topics(bag)))
+        );
     };
     let parent = first.msg.parent.clone();
     if let Some(other) = to_base.iter().find(|a| a.msg.parent != parent) {

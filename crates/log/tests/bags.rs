@@ -2,6 +2,8 @@
 //! first 10 s, converted by the Python `rosbags` library; dev/scripts/make_bag_test_data.sh), and bad bags
 //! refused with errors naming the file and the place.
 
+#![allow(clippy::unwrap_used, reason = "test code: a failed unwrap fails the test")]
+
 use mrslam_core::Xyt;
 use mrslam_log::{LogError, ReadOptions, SensorLog, TopicChoice, read_log};
 use std::path::{Path, PathBuf};
