@@ -11,6 +11,7 @@ mod reliability;
 mod run;
 mod sim;
 mod slam;
+mod slam_bags;
 mod study;
 mod study_logs;
 mod util;
