@@ -36,7 +36,7 @@ enum Command {
     Features(cmd::features::FeaturesArgs),
     /// Merge two or more maps of unknown relative pose (exit 2 when a map cannot be placed).
     Merge(cmd::merge::MergeArgs),
-    /// Inspect CARMEN laser logs.
+    /// Inspect laser logs (CARMEN, ROS 1 and ROS 2 bags).
     #[command(subcommand)]
     Log(cmd::log::LogCommand),
     /// Evaluate results: a trajectory against benchmark relations.
@@ -44,7 +44,7 @@ enum Command {
     Eval(cmd::eval::EvalCommand),
     /// Run a scenario end to end: simulate both robots, map, merge, evaluate against truth.
     Run(cmd::run::RunArgs),
-    /// Map a CARMEN log with GMapping-style particle filter SLAM.
+    /// Map a laser log (CARMEN or a ROS bag) with GMapping-style particle filter SLAM.
     Slam(cmd::slam::SlamArgs),
     /// The simulator: replay a real log in a world; write a simulated run as a log with its truth.
     #[command(subcommand)]

@@ -1,8 +1,8 @@
-//! `mrslam log info`: what a CARMEN laser log holds, and what the reader repaired.
+//! `mrslam log info`: what a laser log (CARMEN, or a ROS 1 / ROS 2 bag) holds, and what the reader repaired.
 
 use anyhow::Result;
 use clap::{Args, Subcommand};
-use mrslam_log::{MAX_STEP_BACK, OdometrySource, ReadOptions, SensorLog, read_log};
+use mrslam_log::{BagSummary, MAX_STEP_BACK, OdometrySource, ReadOptions, SensorLog, TopicChoice, read_log};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -25,9 +25,26 @@ pub struct ReadArgs {
     /// this.
     #[arg(long, default_value_t = 0.0)]
     pub scan_latency: f64,
+    /// A bag's sensor_msgs/LaserScan topic (needed only when it has several).
+    #[arg(long, value_name = "TOPIC")]
+    pub scan: Option<String>,
+    /// A bag's nav_msgs/Odometry topic (needed only when it has several; without one, odometry comes from
+    /// /tf).
+    #[arg(long, value_name = "TOPIC")]
+    pub odom: Option<String>,
+    /// A bag's robot frame: odometry from /tf is the odometry frame's transform to it, the laser's mount its
+    /// /tf_static transform to the scan's frame (by default the frame the laser's /tf_static chain reaches).
+    #[arg(long, value_name = "NAME")]
+    pub base_frame: Option<String>,
 }
 
 impl ReadArgs {
+    /// The bag topic and frame choices, as `, scan /scan, odom /odom, base_frame base_link` (empty when none).
+    pub fn topics_text(&self) -> String {
+        let named = [("scan", &self.scan), ("odom", &self.odom), ("base_frame", &self.base_frame)];
+        named.iter().filter_map(|(k, v)| v.as_ref().map(|v| format!(", {k} {v}"))).collect()
+    }
+
     /// Reads `path` with these options.
     pub fn read(&self, path: &Path) -> Result<SensorLog> {
         if !(self.max_step_back.is_finite() && self.max_step_back >= 0.0) {
@@ -41,6 +58,11 @@ impl ReadArgs {
             max_step_back: self.max_step_back,
             repair_reversing: !self.keep_reversing,
             scan_latency: self.scan_latency,
+            topics: TopicChoice {
+                scan: self.scan.clone(),
+                odom: self.odom.clone(),
+                base_frame: self.base_frame.clone(),
+            },
             ..ReadOptions::default()
         };
         Ok(read_log(path, &options)?)
@@ -50,9 +72,10 @@ impl ReadArgs {
 /// Log subcommands.
 #[derive(Subcommand)]
 pub enum LogCommand {
-    /// Print a CARMEN log's scans, laser, odometry, timing, skipped lines and repairs (.gz ok).
+    /// Print a log's scans, laser, odometry, timing, skipped lines and repairs; for a bag, its topics and
+    /// which of them it would use.
     Info {
-        /// CARMEN log file (plain or gzipped).
+        /// CARMEN log (plain or gzipped), ROS 1 .bag, ROS 2 .mcap or .db3, or a ROS 2 bag folder.
         log: PathBuf,
         /// How to read it.
         #[command(flatten)]
@@ -80,6 +103,9 @@ pub fn run(cmd: LogCommand) -> Result<ExitCode> {
                 );
             }
             println!("log:       {}", log.display());
+            if let Some(bag) = &parsed.bag {
+                print_bag(bag);
+            }
             println!("scans:     {}", parsed.scans.len());
             if let (Some(first), Some(last)) = (parsed.scans.first(), parsed.scans.last()) {
                 let s = &first.scan;
@@ -103,11 +129,19 @@ pub fn run(cmd: LogCommand) -> Result<ExitCode> {
                     println!("           beam counts differ between scans: {counts:?}");
                 }
             }
-            println!(
-                "odometry:  {} ODOM lines; scans use {}",
-                parsed.odometry.len(),
-                parsed.repairs.describe_odometry()
-            );
+            match &parsed.bag {
+                Some(bag) => println!(
+                    "odometry:  {} readings from {}, interpolated at {} scans' stamps",
+                    parsed.odometry.len(),
+                    bag.odometry,
+                    parsed.repairs.interpolated_odometry
+                ),
+                None => println!(
+                    "odometry:  {} ODOM lines; scans use {}",
+                    parsed.odometry.len(),
+                    parsed.repairs.describe_odometry()
+                ),
+            }
             println!("repairs:   {}", parsed.repairs.describe());
             println!("params:    {}", parsed.params.len());
             let skipped: Vec<String> = parsed.skipped.iter().map(|(k, n)| format!("{n} {k}")).collect();
@@ -115,4 +149,18 @@ pub fn run(cmd: LogCommand) -> Result<ExitCode> {
         }
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// A bag's format, topics and the ones the read used.
+fn print_bag(bag: &BagSummary) {
+    println!("format:    {}", bag.format);
+    println!("topics:    {}", bag.topics.len());
+    let width = bag.topics.iter().map(|t| t.name.len()).max().unwrap_or(0);
+    let type_width = bag.topics.iter().map(|t| t.type_name.len()).max().unwrap_or(0);
+    for t in &bag.topics {
+        let rate = t.rate().map_or_else(|| "-".to_string(), |r| format!("{r:.2} Hz"));
+        println!("           {:width$}  {:type_width$}  {:>7} msgs  {rate}", t.name, t.type_name, t.count);
+    }
+    println!("uses:      scans from {}; odometry from {}", bag.scan_topic, bag.odometry);
+    println!("mount:     {}", bag.laser_mount);
 }

@@ -1,4 +1,4 @@
-//! `mrslam slam LOG -o MAP.yaml`: GMapping-style SLAM on a CARMEN log.
+//! `mrslam slam LOG -o MAP.yaml`: GMapping-style SLAM on a laser log (CARMEN, or a ROS 1 / ROS 2 bag).
 //!
 //! Leniency: NaN/negative beams are counted and ignored; scans whose odometry did not move enough are
 //! skipped (counted); sensor lines out of stamp order are reordered and repeated scans dropped (mrslam-log's
@@ -24,7 +24,7 @@ use std::process::ExitCode;
 /// Arguments of `mrslam slam`.
 #[derive(Args, Debug)]
 pub struct SlamArgs {
-    /// CARMEN log (.clf/.log, gzipped or not).
+    /// Laser log: CARMEN (.clf/.log, gzipped or not), ROS 1 .bag, ROS 2 .mcap or .db3, or a ROS 2 bag folder.
     pub log: PathBuf,
     /// Output map YAML (the PGM and a PNG preview are written beside it).
     #[arg(short, long)]

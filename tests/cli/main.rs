@@ -14,6 +14,7 @@ mod run;
 mod sim;
 mod sim_log;
 mod slam;
+mod slam_bags;
 mod study;
 mod study_logs;
 mod util;

@@ -57,10 +57,20 @@ pub enum LogError {
         /// Whether the file is gzipped.
         compressed: bool,
     },
+    /// A recorded bag that cannot be read as asked: cut off, a chunk that does not decompress, no scan topic
+    /// or several without a choice.
+    #[error("{path}: {message}")]
+    Bag {
+        /// File at fault.
+        path: PathBuf,
+        /// What is wrong, and where (topic, byte offset).
+        message: String,
+    },
     /// The file is in no format a reader of this crate knows.
     #[error(
         "{path}: not a log format mrslam reads (expected a CARMEN log: .clf or .log, plain or gzipped, text lines \
-         such as FLASER, ROBOTLASER1, ODOM, PARAM)"
+         such as FLASER, ROBOTLASER1, ODOM, PARAM; a ROS 1 .bag; a ROS 2 bag: .mcap, .db3 or a folder with \
+         metadata.yaml)"
     )]
     UnknownFormat {
         /// File at fault.

@@ -33,8 +33,21 @@ impl std::fmt::Display for OdometrySource {
     }
 }
 
+/// Which topics and frame a recorded bag's scans and odometry come from; `None` picks the one candidate
+/// the bag has (and refuses a bag with several, naming them). CARMEN logs ignore it.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct TopicChoice {
+    /// The `sensor_msgs/LaserScan` topic of the scans (`--scan`).
+    pub scan: Option<String>,
+    /// The `nav_msgs/Odometry` topic of the odometry (`--odom`); without one, odometry comes from `/tf`.
+    pub odom: Option<String>,
+    /// The robot's frame (`--base-frame`): odometry from `/tf` is the transform from the odometry frame to
+    /// it, and the laser's mount is its transform to the scan's frame in `/tf_static`.
+    pub base_frame: Option<String>,
+}
+
 /// How a log is read.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct ReadOptions {
     /// Where each scan's odometry comes from.
     pub odometry: OdometrySource,
@@ -57,6 +70,8 @@ pub struct ReadOptions {
     /// Most bytes a log may hold once decompressed ([`MAX_LOG_BYTES`]): a larger one (an endless device, a
     /// gzip bomb) is refused when it passes the bound, before it exhausts memory.
     pub max_bytes: u64,
+    /// The topics and frame of a recorded bag.
+    pub topics: TopicChoice,
 }
 
 /// The default bound on stamps stepping back, seconds ([`ReadOptions::max_step_back`]).
@@ -79,6 +94,7 @@ impl Default for ReadOptions {
             scan_latency: 0.0,
             max_line_bytes: MAX_LINE_BYTES,
             max_bytes: MAX_LOG_BYTES,
+            topics: TopicChoice::default(),
         }
     }
 }

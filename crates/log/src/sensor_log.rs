@@ -1,6 +1,7 @@
 //! The neutral sensor log every reader produces: scans with their odometry, the odometry stream, the log's
 //! parameters, what was skipped and what was repaired.
 
+use crate::bag_summary::BagSummary;
 use crate::source::Source;
 use mrslam_core::{LaserScan, Odometry, Pose2};
 use std::collections::BTreeMap;
@@ -44,6 +45,8 @@ pub struct SensorLog {
     pub skipped: BTreeMap<String, usize>,
     /// What the repairs changed: reordering, duplicates, odometry interpolation.
     pub repairs: Repairs,
+    /// A recorded bag's topics and what the read took from them (none for a CARMEN log).
+    pub bag: Option<BagSummary>,
 }
 
 impl SensorLog {

@@ -1,4 +1,4 @@
-//! `mrslam study logs`: a CARMEN log split in time into robots, each part mapped, every connected pair merged.
+//! `mrslam study logs`: a laser log (CARMEN or a ROS bag) split in time into robots, each part mapped, every connected pair merged.
 
 use super::create_out;
 use crate::cmd::args::{one_of, set_each};
@@ -24,7 +24,7 @@ use std::time::Instant;
 /// Arguments of `mrslam study logs`.
 #[derive(Args)]
 pub struct LogsArgs {
-    /// CARMEN log (.clf/.log, gzipped or not).
+    /// Laser log: CARMEN (.clf/.log, gzipped or not), ROS 1 .bag, ROS 2 .mcap or .db3, or a ROS 2 bag folder.
     pub log: PathBuf,
     /// The log's benchmark relations (Kümmerle et al. 2009): the ground truth of each pair of parts.
     #[arg(long)]
@@ -86,9 +86,21 @@ fn part_files(out: &Path, k: usize) -> (PathBuf, PathBuf) {
     (out.join(format!("part-{k}.yaml")), out.join(format!("part-{k}.trajectory.txt")))
 }
 
-/// A file's name and fingerprint, for `study.json`.
+/// A file's name and fingerprint, for `study.json` (a ROS 2 bag folder's: its files' in name order).
 fn file_id(path: &Path) -> Result<String> {
-    let bytes = std::fs::read(path).with_context(|| format!("{}", path.display()))?;
+    let bytes = if path.is_dir() {
+        let mut files: Vec<PathBuf> = std::fs::read_dir(path)
+            .and_then(|d| d.map(|e| e.map(|e| e.path())).collect())
+            .with_context(|| format!("{}", path.display()))?;
+        files.sort();
+        let mut bytes = Vec::new();
+        for f in files.iter().filter(|f| f.is_file()) {
+            bytes.extend(std::fs::read(f).with_context(|| format!("{}", f.display()))?);
+        }
+        bytes
+    } else {
+        std::fs::read(path).with_context(|| format!("{}", path.display()))?
+    };
     Ok(format!("{} {}", path.file_name().map(|f| f.to_string_lossy()).unwrap_or_default(), fingerprint(&bytes)))
 }
 
@@ -133,8 +145,12 @@ pub(super) fn run(a: LogsArgs) -> Result<ExitCode> {
         .set(
             "read",
             format!(
-                "odometry {}, max_step_back {}, keep_reversing {}, scan_latency {}",
-                a.read.odometry, a.read.max_step_back, a.read.keep_reversing, a.read.scan_latency
+                "odometry {}, max_step_back {}, keep_reversing {}, scan_latency {}{}",
+                a.read.odometry,
+                a.read.max_step_back,
+                a.read.keep_reversing,
+                a.read.scan_latency,
+                a.read.topics_text()
             ),
         )
         .set("preset", a.preset)
