@@ -117,8 +117,8 @@ mod tests {
         let e = both.check().unwrap_err().to_string();
         assert!(e.contains("both would write") && e.contains("s.png"), "{e}");
         // An input, or the image an input map names.
-        let e = rule(&d.join("o.yaml"), &log).unwrap_err();
-        assert!(e.contains("refusing to write an output over the input"), "{e}");
+        let e = rule(&yaml, &d.join("t.txt")).unwrap_err();
+        assert!(e.contains("-o") && e.contains("refusing to write an output over the input"), "{e}");
         let e = rule(&d.join("pic.yaml"), &d.join("t.txt")).unwrap_err();
         assert!(e.contains("pic.pgm, the image of the input"), "{e}");
         Ok(())

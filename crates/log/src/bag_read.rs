@@ -4,8 +4,8 @@
 use crate::bag_assemble::assemble;
 use crate::bag_messages::BagMessages;
 use crate::error::LogError;
+use crate::format::Format;
 use crate::options::ReadOptions;
-use crate::read::Format;
 use crate::sensor_log::SensorLog;
 use crate::{mcap_bag, ros1_bag, ros2_folder, sqlite_bag};
 use std::io::BufReader;

@@ -26,6 +26,7 @@ pub mod carmen;
 pub mod carmen_writer;
 mod cdr_msg;
 mod error;
+mod format;
 mod mcap_bag;
 mod options;
 mod read;
@@ -40,7 +41,8 @@ mod sqlite_bag;
 
 pub use bag_summary::{BagSummary, TopicSummary};
 pub use error::LogError;
+pub use format::{Format, format_by_content, format_by_extension};
 pub use options::{MAX_LINE_BYTES, MAX_LOG_BYTES, MAX_STEP_BACK, OdometrySource, ReadOptions, TopicChoice};
-pub use read::{Format, format_by_content, format_by_extension, log_name, read_log};
+pub use read::{log_name, read_log};
 pub use sensor_log::{OdometryRecord, Repairs, ScanRecord, SensorLog};
 pub use source::{Source, span};
