@@ -4,6 +4,7 @@
 
 mod eval;
 mod features;
+mod long_loop;
 mod map;
 mod merge;
 mod merge_many;
