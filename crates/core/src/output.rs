@@ -76,6 +76,14 @@ impl std::io::Write for AtomicFile {
     }
 }
 
+/// Seeking flushes the buffer first (as `BufWriter` does): a writer that goes back to fill in an index (MCAP's)
+/// can write through an [`AtomicFile`].
+impl std::io::Seek for AtomicFile {
+    fn seek(&mut self, pos: std::io::SeekFrom) -> std::io::Result<u64> {
+        self.writer()?.seek(pos)
+    }
+}
+
 impl Drop for AtomicFile {
     fn drop(&mut self) {
         if self.writer.take().is_some() {
