@@ -63,10 +63,11 @@ pub fn run(args: RunArgs) -> Result<ExitCode> {
     inputs.extend(scenario.world.bitmap.as_ref().map(|b| b.map.clone()));
     // Before the long run: the folder can be made, and no output lands on an input or on another output.
     let files = output_files(&scenario, algorithms.as_deref(), &out_dir);
-    let own: Vec<OwnOutput> = [("--rrd", args.viz.rrd.as_deref(), kind::RRD), ("--mcap", args.mcap.as_deref(), kind::MCAP)]
-        .into_iter()
-        .filter_map(|(flag, path, kind)| path.map(|p| (flag, p, kind)))
-        .collect();
+    let own: Vec<OwnOutput> =
+        [("--rrd", args.viz.rrd.as_deref(), kind::RRD), ("--mcap", args.mcap.as_deref(), kind::MCAP)]
+            .into_iter()
+            .filter_map(|(flag, path, kind)| path.map(|p| (flag, p, kind)))
+            .collect();
     let folder = RunFolder::prepare(&out_dir, args.out.is_none(), files, &own, &inputs)?;
     let mut bag = args.mcap.as_deref().map(|p| RunBag::create(p, &scenario)).transpose()?;
     // The same for the recording: a file that cannot be written, or no viewer, fails here.

@@ -181,11 +181,16 @@ mod tests {
         let input = dir.path().join("in.rrd");
         std::fs::write(&input, "an input")?;
         let fresh = dir.path().join("fresh");
-        let e =
-            RunFolder::prepare(&fresh, false, vec![fresh.join("x.json")], &[("--rrd", &input, kind::RRD)], std::slice::from_ref(&input))
-                .err()
-                .map(|e| e.to_string())
-                .unwrap_or_default();
+        let e = RunFolder::prepare(
+            &fresh,
+            false,
+            vec![fresh.join("x.json")],
+            &[("--rrd", &input, kind::RRD)],
+            std::slice::from_ref(&input),
+        )
+        .err()
+        .map(|e| e.to_string())
+        .unwrap_or_default();
         assert!(e.contains("--rrd") && e.contains("refusing to write an output over the input"), "{e}");
         assert!(!fresh.exists());
         Ok(())

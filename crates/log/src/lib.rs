@@ -43,8 +43,8 @@ mod sqlite_bag;
 
 pub use bag_summary::{BagSummary, TopicSummary};
 pub use error::LogError;
-pub use mcap_writer::{McapWriteError, RunBagWriter, WORLD_FRAME, robot_frame};
 pub use format::{Format, format_by_content, format_by_extension};
+pub use mcap_writer::{McapWriteError, RunBagWriter, WORLD_FRAME, robot_frame};
 pub use options::{MAX_LINE_BYTES, MAX_LOG_BYTES, MAX_STEP_BACK, OdometrySource, ReadOptions, TopicChoice};
 pub use read::{log_name, read_log};
 pub use sensor_log::{OdometryRecord, Repairs, ScanRecord, SensorLog};

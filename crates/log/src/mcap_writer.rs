@@ -135,12 +135,14 @@ impl<W: Write + Seek> RunBagWriter<W> {
             let id = self.mcap.add_channel(schema, topic, "cdr", &qos_metadata(latched))?;
             self.channels.insert(topic.to_string(), Channel { id, sequence: 0 });
         }
-        let cdr_error = |e: cdr_encoding::Error| McapWriteError::Cdr { topic: topic.to_string(), message: e.to_string() };
+        let cdr_error =
+            |e: cdr_encoding::Error| McapWriteError::Cdr { topic: topic.to_string(), message: e.to_string() };
         // The encapsulation header: plain CDR, little-endian.
         let mut data = vec![0, 1, 0, 0];
         cdr_encoding::to_writer::<T, LittleEndian, _>(&mut data, message).map_err(cdr_error)?;
         let Some(channel) = self.channels.get_mut(topic) else { return Ok(()) };
-        let header = MessageHeader { channel_id: channel.id, sequence: channel.sequence, log_time: ns, publish_time: ns };
+        let header =
+            MessageHeader { channel_id: channel.id, sequence: channel.sequence, log_time: ns, publish_time: ns };
         channel.sequence = channel.sequence.wrapping_add(1);
         self.mcap.write_to_known_channel(&header, &data)?;
         Ok(())
@@ -324,7 +326,10 @@ mod tests {
                 }
                 "/tf_static" => {
                     let Msg::Transforms(t) = decode(MsgKind::Transforms, &m.data).unwrap() else { panic!() };
-                    assert_eq!((t[0].parent.as_str(), t[0].child.as_str(), t[0].pose.x), ("r1/base_link", "r1/laser", 0.1));
+                    assert_eq!(
+                        (t[0].parent.as_str(), t[0].child.as_str(), t[0].pose.x),
+                        ("r1/base_link", "r1/laser", 0.1)
+                    );
                     seen += 1;
                 }
                 "/r1/map" => {
