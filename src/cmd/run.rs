@@ -83,7 +83,7 @@ pub fn run(args: RunArgs) -> Result<ExitCode> {
             .as_deref()
             .map(|r| format!("; the recording so far, without its footer: {}", mrslam_viz::partial_path(r).display()))
             .unwrap_or_default()
-            + &args.mcap.as_deref().map(|p| format!("; {} was not written", p.display())).unwrap_or_default()
+            + &bag.as_ref().map(RunBag::interrupted).unwrap_or_default()
     ));
     let bar = ProgressBar::new((scenario.duration * 10.0) as u64);
     if args.quiet || !std::io::stderr().is_terminal() {

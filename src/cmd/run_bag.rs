@@ -12,6 +12,8 @@ use std::path::{Path, PathBuf};
 /// A run's bag as it is written.
 pub struct RunBag {
     path: PathBuf,
+    /// The hidden name it is written under until the rename.
+    partial: PathBuf,
     writer: RunBagWriter<AtomicFile>,
     /// The first write error: the run goes on, the bag is refused at the end.
     error: Option<anyhow::Error>,
@@ -29,10 +31,16 @@ impl RunBag {
     pub fn create(path: &Path, scenario: &Scenario) -> Result<Self> {
         let context = || format!("--mcap {}", path.display());
         let file = AtomicFile::create(path).with_context(context)?;
+        let partial = file.temporary_path().to_path_buf();
         let mut writer = RunBagWriter::new(file).with_context(context)?;
         let mounts: Vec<(&str, _)> = scenario.robots.iter().map(|r| (r.name.as_str(), r.lidar.mount)).collect();
         writer.mounts(0.0, &mounts).with_context(context)?;
-        Ok(Self { path: path.to_path_buf(), writer, error: None })
+        Ok(Self { path: path.to_path_buf(), partial, writer, error: None })
+    }
+
+    /// What an interruption leaves: the bag so far under its temporary name, without its summary.
+    pub fn interrupted(&self) -> String {
+        format!("; the bag so far, without its summary and indexes: {}", self.partial.display())
     }
 
     /// Writes what robot `s.robot` did in a step: its SLAM's `map -> odom` (as it stood before the step's

@@ -50,6 +50,12 @@ impl AtomicFile {
         &self.path
     }
 
+    /// The hidden temporary file the bytes go to until [`AtomicFile::commit`] (left behind only if the process is
+    /// killed before it commits or drops the writer).
+    pub fn temporary_path(&self) -> &Path {
+        &self.tmp
+    }
+
     /// Flushes, syncs and renames the temporary file to the final name.
     pub fn commit(mut self) -> Result<(), WriteError> {
         let result = (|| {
