@@ -20,6 +20,7 @@ use mcap::{McapError, WriteOptions, Writer};
 use mrslam_core::{LaserScan, OccupancyGrid, Odometry, Pose2, Xyt};
 use serde::Serialize;
 use std::collections::BTreeMap;
+use std::collections::btree_map::Entry;
 use std::io::{Seek, Write};
 
 /// The frame the true poses and the true map are in.
@@ -123,24 +124,26 @@ impl<W: Write + Seek> RunBagWriter<W> {
         let latched = matches!(ty, Ros2Type::OccupancyGrid) || topic == "/tf_static";
         let time = ros_time(topic, log_time)?;
         let ns = u64::from(time.sec as u32) * 1_000_000_000 + u64::from(time.nanosec);
-        if !self.channels.contains_key(topic) {
-            let schema = match self.schemas.get(&ty.name()) {
-                Some(&id) => id,
-                None => {
-                    let id = self.mcap.add_schema(&ty.name(), "ros2msg", ty.definition().as_bytes())?;
-                    self.schemas.insert(ty.name(), id);
-                    id
-                }
-            };
-            let id = self.mcap.add_channel(schema, topic, "cdr", &qos_metadata(latched))?;
-            self.channels.insert(topic.to_string(), Channel { id, sequence: 0 });
-        }
         let cdr_error =
             |e: cdr_encoding::Error| McapWriteError::Cdr { topic: topic.to_string(), message: e.to_string() };
         // The encapsulation header: plain CDR, little-endian.
         let mut data = vec![0, 1, 0, 0];
         cdr_encoding::to_writer::<T, LittleEndian, _>(&mut data, message).map_err(cdr_error)?;
-        let Some(channel) = self.channels.get_mut(topic) else { return Ok(()) };
+        let channel = match self.channels.entry(topic.to_string()) {
+            Entry::Occupied(e) => e.into_mut(),
+            Entry::Vacant(e) => {
+                let schema = match self.schemas.get(&ty.name()) {
+                    Some(&id) => id,
+                    None => {
+                        let id = self.mcap.add_schema(&ty.name(), "ros2msg", ty.definition().as_bytes())?;
+                        self.schemas.insert(ty.name(), id);
+                        id
+                    }
+                };
+                let id = self.mcap.add_channel(schema, topic, "cdr", &qos_metadata(latched))?;
+                e.insert(Channel { id, sequence: 0 })
+            }
+        };
         let header =
             MessageHeader { channel_id: channel.id, sequence: channel.sequence, log_time: ns, publish_time: ns };
         channel.sequence = channel.sequence.wrapping_add(1);
