@@ -13,6 +13,7 @@ pub mod outputs;
 pub mod paths;
 pub mod replay_plot;
 pub mod run;
+pub mod run_bag;
 pub mod run_folder;
 pub mod sim;
 pub mod sim_log;

@@ -18,6 +18,8 @@ pub mod kind {
     pub const PNG: &[&str] = &["png"];
     /// A rerun recording.
     pub const RRD: &[&str] = &["rrd"];
+    /// A ROS 2 bag in one MCAP file.
+    pub const MCAP: &[&str] = &["mcap"];
     /// A text table of poses, `stamp x y theta` per line.
     pub const TRAJECTORY: &[&str] = &["txt", "dat"];
     /// A TOML file (worlds).

@@ -1,11 +1,13 @@
 //! `mrslam run SCENARIO.toml`: a paper scenario end to end — simulate, map, merge, evaluate, report.
 
-use super::run_folder::RunFolder;
+use super::outputs::kind;
+use super::run_bag::RunBag;
+use super::run_folder::{OwnOutput, RunFolder};
 use anyhow::{Result, bail};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use mrslam_merge::Algorithm;
-use mrslam_testbed::runner::{RunOptions, output_files, run as run_scenario, write_outputs};
+use mrslam_testbed::runner::{RobotStep, RunOptions, StepTap, output_files, run as run_scenario, write_outputs};
 use mrslam_testbed::scenario::Scenario;
 use mrslam_viz::RunRecorder;
 use std::io::IsTerminal;
@@ -28,6 +30,11 @@ pub struct RunArgs {
     /// Override the scenario's seed.
     #[arg(long, allow_negative_numbers = true)]
     pub seed: Option<u64>,
+    /// Also write the run as a ROS 2 bag (one MCAP file, for `ros2 bag play`, Foxglove or another SLAM): per
+    /// robot /NAME/scan, /NAME/odom, /NAME/ground_truth and /NAME/map, /tf, /tf_static, /truth_map and the
+    /// merged map (/merged_map).
+    #[arg(long, value_name = "OUT.mcap")]
+    pub mcap: Option<PathBuf>,
     /// No progress bar.
     #[arg(long)]
     pub quiet: bool,
@@ -56,7 +63,13 @@ pub fn run(args: RunArgs) -> Result<ExitCode> {
     inputs.extend(scenario.world.bitmap.as_ref().map(|b| b.map.clone()));
     // Before the long run: the folder can be made, and no output lands on an input or on another output.
     let files = output_files(&scenario, algorithms.as_deref(), &out_dir);
-    let folder = RunFolder::prepare(&out_dir, args.out.is_none(), files, args.viz.rrd.as_deref(), &inputs)?;
+    let own: Vec<OwnOutput> =
+        [("--rrd", args.viz.rrd.as_deref(), kind::RRD), ("--mcap", args.mcap.as_deref(), kind::MCAP)]
+            .into_iter()
+            .filter_map(|(flag, path, kind)| path.map(|p| (flag, p, kind)))
+            .collect();
+    let folder = RunFolder::prepare(&out_dir, args.out.is_none(), files, &own, &inputs)?;
+    let mut bag = args.mcap.as_deref().map(|p| RunBag::create(p, &scenario)).transpose()?;
     // The same for the recording: a file that cannot be written, or no viewer, fails here.
     let recording_id = format!("{}-seed{}", scenario.name, scenario.seed);
     let name = format!("{} (seed {})", scenario.name, scenario.seed);
@@ -70,6 +83,7 @@ pub fn run(args: RunArgs) -> Result<ExitCode> {
             .as_deref()
             .map(|r| format!("; the recording so far, without its footer: {}", mrslam_viz::partial_path(r).display()))
             .unwrap_or_default()
+            + &bag.as_ref().map(RunBag::interrupted).unwrap_or_default()
     ));
     let bar = ProgressBar::new((scenario.duration * 10.0) as u64);
     if args.quiet || !std::io::stderr().is_terminal() {
@@ -90,23 +104,29 @@ pub fn run(args: RunArgs) -> Result<ExitCode> {
             bar.set_prefix(format!("{t:.0}/{end:.0}"));
         })),
         viz: viz.as_mut(),
-        on_step: None,
+        on_step: bag.as_mut().map(|b| Box::new(|s: &RobotStep<'_>| b.step(s)) as StepTap),
     };
     let out = run_scenario(&scenario, opts)?;
     bar.finish_and_clear();
+    let bag = bag.map(|b| b.finish(&out)).transpose()?;
     // An interruption waits while the files are moved into place together.
-    let (removed, interrupted) =
-        super::interrupt::moving(|| folder.commit(|staging| Ok(write_outputs(&out, staging)?)));
+    let (removed, interrupted) = super::interrupt::moving(|| {
+        let removed = folder.commit(|staging| Ok(write_outputs(&out, staging)?))?;
+        Ok::<_, anyhow::Error>((removed, bag.map(|b| b.commit()).transpose()?))
+    });
     if interrupted {
         eprintln!("mrslam run: interrupted; the outputs were moved into place first ({})", out_dir.display());
         return Ok(ExitCode::from(130));
     }
-    let removed = removed?;
+    let (removed, bag) = removed?;
     for r in removed {
         println!("removed:  {} (an earlier run's, not written by this one)", r.display());
     }
     print!("{}", out.report.summary());
     println!("outputs:  {}", out_dir.display());
+    if let Some(b) = bag {
+        println!("ROS 2 bag: {}", b.display());
+    }
     if let Some(v) = viz {
         let stats = v.finish()?;
         println!("rerun:    {} ({} rows in {} chunks)", args.viz.describe(), stats.rows, stats.chunks);

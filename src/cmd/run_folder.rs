@@ -18,18 +18,23 @@ pub const MANIFEST: &str = "run-files.txt";
 pub struct RunFolder {
     dir: PathBuf,
     files: Vec<PathBuf>,
-    recording: Option<PathBuf>,
+    /// The run's own files given by their own flags (`--rrd`, `--mcap`), written in place, not staged.
+    own: Vec<PathBuf>,
 }
+
+/// A file of a run given by its own flag: the flag, the file, the kind of file it must be.
+pub type OwnOutput<'p> = (&'static str, &'p Path, &'static [&'static str]);
 
 impl RunFolder {
     /// Makes `dir` when it is not there (its parent must exist unless `make_parents`: a typo in `--out` makes
-    /// no chain of folders), then checks `files` (the run's outputs in `dir`) and the `recording` by the one
-    /// output rule against `inputs`. A folder made here is removed again when the check fails.
+    /// no chain of folders), then checks `files` (the run's outputs in `dir`) and the files given by their own
+    /// flags (`own`: a recording, a bag) by the one output rule against `inputs`. A folder made here is removed
+    /// again when the check fails.
     pub fn prepare(
         dir: &Path,
         make_parents: bool,
         files: Vec<PathBuf>,
-        recording: Option<&Path>,
+        own: &[OwnOutput<'_>],
         inputs: &[PathBuf],
     ) -> Result<RunFolder> {
         let made = !dir.exists();
@@ -51,13 +56,17 @@ impl RunFolder {
         for f in files.iter().filter(|f| !beside_a_map(f)).chain([&manifest]) {
             rule = rule.file("--out", f, kind::ANY);
         }
-        if let Err(e) = rule.maybe("--rrd", recording, kind::RRD).check() {
+        for (flag, path, kind) in own {
+            rule = rule.file(flag, path, kind);
+        }
+        if let Err(e) = rule.check() {
             if made {
                 let _ = std::fs::remove_dir(dir);
             }
             return Err(e);
         }
-        Ok(RunFolder { dir: dir.to_path_buf(), files, recording: recording.map(Path::to_path_buf) })
+        let own = own.iter().map(|(_, p, _)| p.to_path_buf()).collect();
+        Ok(RunFolder { dir: dir.to_path_buf(), files, own })
     }
 
     /// Calls `write` on a staging folder inside the run's folder, moves what it wrote into place, removes the
@@ -72,7 +81,7 @@ impl RunFolder {
         // The earlier run's files: its manifest's, and any of this run's names it left (a refused merge's map).
         let mut earlier = self.manifest();
         earlier.extend(self.files.iter().filter_map(|f| plain_name(f)));
-        if let Some(r) = self.recording.as_deref().filter(|r| r.parent() == Some(self.dir.as_path())) {
+        for r in self.own.iter().filter(|r| r.parent() == Some(self.dir.as_path())) {
             written.extend(plain_name(r));
         }
         let mut removed = Vec::new();
@@ -140,7 +149,7 @@ mod tests {
         let dir = tempfile::tempdir()?;
         let d = dir.path();
         let files = vec![d.join("a.json"), d.join("b.json")];
-        let folder = RunFolder::prepare(d, false, files.clone(), None, &[])?;
+        let folder = RunFolder::prepare(d, false, files.clone(), &[], &[])?;
         folder.commit(|s| {
             std::fs::write(s.join("a.json"), "1")?;
             std::fs::write(s.join("b.json"), "1")?;
@@ -166,17 +175,22 @@ mod tests {
     fn a_missing_parent_is_refused_and_an_output_over_an_input_removes_the_folder_it_made() -> Result<()> {
         let dir = tempfile::tempdir()?;
         let deep = dir.path().join("missing/deep");
-        let e = RunFolder::prepare(&deep, false, vec![], None, &[]).err().map(|e| e.to_string()).unwrap_or_default();
+        let e = RunFolder::prepare(&deep, false, vec![], &[], &[]).err().map(|e| e.to_string()).unwrap_or_default();
         assert!(e.contains("does not exist"), "{e}");
         assert!(!dir.path().join("missing").exists());
         let input = dir.path().join("in.rrd");
         std::fs::write(&input, "an input")?;
         let fresh = dir.path().join("fresh");
-        let e =
-            RunFolder::prepare(&fresh, false, vec![fresh.join("x.json")], Some(&input), std::slice::from_ref(&input))
-                .err()
-                .map(|e| e.to_string())
-                .unwrap_or_default();
+        let e = RunFolder::prepare(
+            &fresh,
+            false,
+            vec![fresh.join("x.json")],
+            &[("--rrd", &input, kind::RRD)],
+            std::slice::from_ref(&input),
+        )
+        .err()
+        .map(|e| e.to_string())
+        .unwrap_or_default();
         assert!(e.contains("--rrd") && e.contains("refusing to write an output over the input"), "{e}");
         assert!(!fresh.exists());
         Ok(())

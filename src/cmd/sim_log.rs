@@ -3,6 +3,7 @@
 //! another, can be scored on the testbed's worlds.
 
 use super::outputs::{Outputs, kind};
+use super::run_bag::RunBag;
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -41,6 +42,11 @@ pub struct LogArgs {
     /// ... with at least this many metres of driving between them.
     #[arg(long, default_value_t = TruthRelations::default().loop_min_travel)]
     pub loop_min_travel: f64,
+    /// Also write the run as a ROS 2 bag (one MCAP file, for `ros2 bag play`, Foxglove or another SLAM): per
+    /// robot /NAME/scan, /NAME/odom, /NAME/ground_truth and /NAME/map (the robot's SLAM map), /tf, /tf_static
+    /// and /truth_map.
+    #[arg(long, value_name = "OUT.mcap")]
+    pub mcap: Option<PathBuf>,
     /// No progress bar.
     #[arg(long)]
     pub quiet: bool,
@@ -105,7 +111,9 @@ pub fn run(args: LogArgs) -> Result<ExitCode> {
     outputs
         .iter()
         .fold(Outputs::reading(inputs.iter().map(PathBuf::as_path)), |rule, o| rule.file("sim log --out", o, kind::ANY))
+        .maybe("--mcap", args.mcap.as_deref(), kind::MCAP)
         .check()?;
+    let mut bag = args.mcap.as_deref().map(|p| RunBag::create(p, &scenario)).transpose()?;
     let mut logs = Vec::new();
     for r in &scenario.robots {
         let [clf, ..] = robot_files(&args.out, &r.name);
@@ -142,6 +150,9 @@ pub fn run(args: LogArgs) -> Result<ExitCode> {
     let mut write_error: Option<anyhow::Error> = None;
     let odom_lines = !args.no_odom_lines;
     let tap = |s: &RobotStep<'_>| {
+        if let Some(b) = bag.as_mut() {
+            b.step(s);
+        }
         if write_error.is_some() {
             return;
         }
@@ -186,6 +197,7 @@ pub fn run(args: LogArgs) -> Result<ExitCode> {
     if let Some(e) = write_error {
         return Err(e);
     }
+    let bag = bag.map(|b| b.finish(&out)).transpose()?;
     let mut robots = Vec::new();
     for log in logs {
         let [clf, truth_path, relations_path] = robot_files(&args.out, &log.name);
@@ -248,5 +260,8 @@ pub fn run(args: LogArgs) -> Result<ExitCode> {
     let text = serde_json::to_string_pretty(&summary).context("log.json")? + "\n";
     write_file_atomic(&summary_path, text.as_bytes())?;
     println!("outputs:  {}", args.out.display());
+    if let Some(b) = bag {
+        println!("ROS 2 bag: {}", b.commit()?.display());
+    }
     Ok(ExitCode::SUCCESS)
 }

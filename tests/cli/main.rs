@@ -12,6 +12,7 @@ mod reliability;
 mod reliability_inputs;
 mod reliability_outputs;
 mod run;
+mod run_mcap;
 mod sim;
 mod sim_log;
 mod slam;

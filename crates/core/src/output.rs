@@ -50,6 +50,12 @@ impl AtomicFile {
         &self.path
     }
 
+    /// The hidden temporary file the bytes go to until [`AtomicFile::commit`] (left behind only if the process is
+    /// killed before it commits or drops the writer).
+    pub fn temporary_path(&self) -> &Path {
+        &self.tmp
+    }
+
     /// Flushes, syncs and renames the temporary file to the final name.
     pub fn commit(mut self) -> Result<(), WriteError> {
         let result = (|| {
@@ -73,6 +79,14 @@ impl std::io::Write for AtomicFile {
 
     fn flush(&mut self) -> std::io::Result<()> {
         self.writer()?.flush()
+    }
+}
+
+/// Seeking flushes the buffer first (as `BufWriter` does): a writer that goes back to fill in an index (MCAP's)
+/// can write through an [`AtomicFile`].
+impl std::io::Seek for AtomicFile {
+    fn seek(&mut self, pos: std::io::SeekFrom) -> std::io::Result<u64> {
+        self.writer()?.seek(pos)
     }
 }
 

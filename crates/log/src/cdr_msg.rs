@@ -1,79 +1,12 @@
 //! ROS 2 CDR encoding of the three message types ([`crate::ros_msg`]), through the `cdr-encoding` crate
-//! (serde; RustDDS's CDR, maintained by Atostek): the message structs below mirror the ROS 2 (Humble)
-//! definitions field for field, and the 4-byte encapsulation header in front of every serialized message
-//! says the byte order.
+//! (serde; RustDDS's CDR, maintained by Atostek) into the message structs of [`crate::ros2_msg`], which mirror
+//! the ROS 2 (Humble) definitions field for field; the 4-byte encapsulation header in front of every
+//! serialized message says the byte order.
 
 use crate::ros_msg::{Msg, MsgKind, OdometryMsg, Planar, ScanMsg, TransformMsg, stamp_seconds};
+use crate::ros2_msg::{LaserScan, Odometry, Pose, TfMessage, Time};
 use byteorder::{BigEndian, LittleEndian};
 use serde::Deserialize;
-
-/// `builtin_interfaces/Time`.
-#[derive(Deserialize)]
-struct Time {
-    sec: i32,
-    nanosec: u32,
-}
-
-/// `std_msgs/Header`.
-#[derive(Deserialize)]
-struct Header {
-    stamp: Time,
-    frame_id: String,
-}
-
-/// `geometry_msgs/Pose` (and `Transform`: a translation and a rotation, laid out alike).
-#[derive(Deserialize)]
-struct Pose {
-    position: [f64; 3],
-    orientation: [f64; 4],
-}
-
-/// A `float64[36]` covariance, as two halves: serde derives arrays of up to 32 elements, and a fixed
-/// array is its elements back to back in CDR, so the bytes are the same.
-#[derive(Deserialize)]
-#[allow(dead_code)] // read past, never used
-struct Covariance([f64; 18], [f64; 18]);
-
-/// `sensor_msgs/LaserScan`.
-#[derive(Deserialize)]
-struct LaserScan {
-    header: Header,
-    angle_min: f32,
-    _angle_max: f32,
-    angle_increment: f32,
-    _time_increment: f32,
-    _scan_time: f32,
-    range_min: f32,
-    range_max: f32,
-    ranges: Vec<f32>,
-    _intensities: Vec<f32>,
-}
-
-/// `nav_msgs/Odometry`.
-#[derive(Deserialize)]
-struct Odometry {
-    header: Header,
-    child_frame_id: String,
-    pose: Pose,
-    _pose_covariance: Covariance,
-    twist_linear: [f64; 3],
-    _twist_angular: [f64; 3],
-    _twist_covariance: Covariance,
-}
-
-/// `geometry_msgs/TransformStamped`.
-#[derive(Deserialize)]
-struct TransformStamped {
-    header: Header,
-    child_frame_id: String,
-    transform: Pose,
-}
-
-/// `tf2_msgs/TFMessage`.
-#[derive(Deserialize)]
-struct TfMessage {
-    transforms: Vec<TransformStamped>,
-}
 
 fn stamp(t: &Time) -> Result<f64, String> {
     stamp_seconds(i64::from(t.sec), t.nanosec)
@@ -115,8 +48,8 @@ pub(crate) fn decode(kind: MsgKind, bytes: &[u8]) -> Result<Msg, String> {
                 stamp: stamp(&m.header.stamp)?,
                 frame_id: m.header.frame_id,
                 child_frame_id: m.child_frame_id,
-                pose: planar(&m.pose),
-                forward_speed: m.twist_linear[0],
+                pose: planar(&m.pose.pose),
+                forward_speed: m.twist.linear[0],
             })
         }
         MsgKind::Transforms => {

@@ -24,6 +24,8 @@ pub(super) struct Agent<'s> {
     pub last_scan: Option<LaserScan>,
     /// (truth, odometry) at each processed scan, in the world and odometry frames.
     pub processed: Vec<(Pose2, Pose2)>,
+    /// The odometry pose of the last reading fed to SLAM (its best pose is the robot's there).
+    pub fed_odometry: Option<Pose2>,
     pub scans: usize,
     pub distance: f64,
     pub last: Pose2,
@@ -37,6 +39,12 @@ impl Agent<'_> {
     /// True once the controller is done.
     pub fn finished(&self) -> bool {
         self.controller.is_done()
+    }
+
+    /// Where the robot's SLAM puts its odometry frame in its map (ROS's `map -> odom`): its best pose times
+    /// the inverse of the odometry pose it was fed last; `None` before its first reading.
+    pub fn map_to_odom(&self) -> Option<Pose2> {
+        self.fed_odometry.map(|odom| self.slam.best_pose() * odom.inverse())
     }
 
     /// The SLAM error of this robot as a [`RunError`].
@@ -76,6 +84,7 @@ impl Agent<'_> {
             let t = Instant::now();
             let outcome = self.slam.process(&odom, &scan).map_err(|error| self.slam_error(error))?;
             self.slam_s += t.elapsed().as_secs_f64();
+            self.fed_odometry = Some(odom.pose);
             if outcome.is_processed() {
                 self.processed.push((true_pose, odom.pose));
             }
@@ -138,6 +147,7 @@ pub(super) fn add_robots<'s>(
             controller,
             last_scan: None,
             processed: Vec::new(),
+            fed_odometry: None,
             scans: 0,
             distance: 0.0,
             last: r.start,

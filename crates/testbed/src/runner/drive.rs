@@ -72,6 +72,7 @@ pub(super) fn drive(
                     odometry: &odometry,
                     scans: &scans,
                     mount: &a.setup.lidar.mount,
+                    map_to_odom: a.map_to_odom(),
                 });
             }
         }

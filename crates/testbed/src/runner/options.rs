@@ -67,6 +67,9 @@ pub struct RobotStep<'s> {
     pub scans: &'s [&'s LaserScan],
     /// The lidar's mount on the robot.
     pub mount: &'s Pose2,
+    /// Where the robot's SLAM puts its odometry frame in its map (ROS's `map -> odom`), from its pose estimate
+    /// after the scans before this step; `None` before its first scan.
+    pub map_to_odom: Option<Pose2>,
 }
 
 /// Everything a run produced.
