@@ -54,11 +54,15 @@ pub(crate) struct BagMessages {
     /// The transforms of `/tf_static` (topics named `..._static`).
     pub static_transforms: Vec<TransformMsg>,
     arrivals: usize,
+    /// The bytes of every message so far (decompressed), and their bound.
+    bytes: u64,
+    max_bytes: u64,
 }
 
 impl BagMessages {
-    /// No messages yet, of the bag at `path`.
-    pub(crate) fn new(path: &Path) -> BagMessages {
+    /// No messages yet, of the bag at `path`, whose messages may hold `max_bytes` in all
+    /// ([`ReadOptions::max_bytes`](crate::ReadOptions::max_bytes)).
+    pub(crate) fn new(path: &Path, max_bytes: u64) -> BagMessages {
         BagMessages {
             path: path.to_path_buf(),
             topics: BTreeMap::new(),
@@ -67,6 +71,8 @@ impl BagMessages {
             transforms: Vec::new(),
             static_transforms: Vec::new(),
             arrivals: 0,
+            bytes: 0,
+            max_bytes,
         }
     }
 
@@ -80,6 +86,12 @@ impl BagMessages {
         bag_time_ns: u64,
         bytes: &[u8],
     ) -> Result<(), LogError> {
+        // Bounded here, where every reader's messages arrive decompressed: a bag bomb (small chunks that
+        // decompress to many messages) is refused when their bytes pass the bound, before they fill memory.
+        self.bytes += bytes.len() as u64;
+        if self.bytes > self.max_bytes {
+            return Err(LogError::TooLarge { path: self.path.clone(), limit: self.max_bytes, compressed: false });
+        }
         let t = bag_time_ns as f64 * 1e-9;
         let summary = self.topics.entry(topic.to_string()).or_insert_with(|| TopicSummary {
             name: topic.to_string(),

@@ -13,7 +13,7 @@ use std::path::Path;
 
 /// Reads the bag at `path` (a file of `format`, or a ROS 2 bag folder) with `options`.
 pub(crate) fn read_bag(path: &Path, format: Format, options: &ReadOptions) -> Result<SensorLog, LogError> {
-    let mut bag = BagMessages::new(path);
+    let mut bag = BagMessages::new(path, options.max_bytes);
     let open = || {
         std::fs::File::open(path).map(BufReader::new).map_err(|cause| LogError::Io { path: path.to_path_buf(), cause })
     };

@@ -46,7 +46,7 @@ pub enum LogError {
     },
     /// More bytes than [`ReadOptions::max_bytes`](crate::ReadOptions::max_bytes), once decompressed.
     #[error(
-        "{path}: more than {}{}: refused before it exhausts memory (an endless device, or a gzip bomb?)",
+        "{path}: more than {}{}: refused before it exhausts memory (an endless device, or a compression bomb?)",
         size_text(*.limit), if *.compressed { " once decompressed" } else { "" }
     )]
     TooLarge {

@@ -3,16 +3,25 @@
 //! in memory, records no larger than [`MAX_RECORD_BYTES`], each chunk's CRC checked before its messages are
 //! read. Messages encoded `cdr`
 //! (ROS 2) or `ros1` are decoded by their schema's name.
+//!
+//! Two guards keep a small file from claiming large allocations (both found by fuzzing): the reader's read
+//! requests are served [`READ_BYTES`] at a time (it asks for as many bytes as a record's header claims,
+//! 4 GiB for a chunk whose compression name claims it), and only the records the log needs (schemas,
+//! channels, messages, chunk indexes) are parsed, once their length prefixes are checked against the
+//! record ([`prefixes_fit`]): `mcap::parse_record` reserves what a string's prefix claims before reading it.
 
 use crate::bag_messages::{BagMessages, MAX_RECORD_BYTES, Wire};
 use crate::error::LogError;
-use mcap::records::Record;
+use mcap::records::{Record, op};
 use mcap::sans_io::linear_reader::{LinearReadEvent, LinearReader, LinearReaderOptions};
 use std::collections::{BTreeMap, BTreeSet};
 use std::io::Read;
 
 /// The first bytes of an MCAP file.
 pub(crate) const MAGIC: &[u8] = b"\x89MCAP0\r\n";
+
+/// The most bytes handed to the reader at a time.
+const READ_BYTES: usize = 1 << 20;
 
 /// A channel: its topic, its schema's name and its message encoding.
 struct Channel {
@@ -39,11 +48,21 @@ pub(crate) fn read(mut r: impl Read, bag: &mut BagMessages) -> Result<String, Lo
     while let Some(event) = reader.next_event() {
         match event.map_err(|e| mcap_err(fed, e))? {
             LinearReadEvent::ReadRequest(need) => {
-                let n = r.read(reader.insert(need)).map_err(|e| LogError::Io { path: path.clone(), cause: e })?;
+                let n = r
+                    .read(reader.insert(need.min(READ_BYTES)))
+                    .map_err(|e| LogError::Io { path: path.clone(), cause: e })?;
                 reader.notify_read(n);
                 fed += n as u64;
             }
             LinearReadEvent::Record { opcode, data } => {
+                if !matches!(opcode, op::SCHEMA | op::CHANNEL | op::MESSAGE | op::CHUNK_INDEX) {
+                    continue;
+                }
+                if !prefixes_fit(opcode, data) {
+                    return Err(bag.error(format!(
+                        "MCAP, within the first {fed} bytes: a record (opcode {opcode:#04x}) whose fields run past its end"
+                    )));
+                }
                 let record = mcap::parse_record(opcode, data).map_err(|e| mcap_err(fed, e))?;
                 match record {
                     Record::Schema { header, .. } => {
@@ -81,4 +100,92 @@ pub(crate) fn read(mut r: impl Read, bag: &mut BagMessages) -> Result<String, Lo
     let kinds: Vec<String> =
         compressions.into_iter().map(|c| if c.is_empty() { "uncompressed".to_string() } else { c }).collect();
     Ok(if kinds.is_empty() { "MCAP".to_string() } else { format!("MCAP ({} chunks)", kinds.join(" and ")) })
+}
+
+/// Whether the length-prefixed fields of a schema, channel or chunk index record (strings, maps, the
+/// schema's data) all lie within `body`, so that parsing it reserves no more than the record holds.
+fn prefixes_fit(opcode: u8, body: &[u8]) -> bool {
+    let mut f = Fields(body);
+    match opcode {
+        // id; name, encoding, data.
+        op::SCHEMA => f.skip(2) && f.prefixed() && f.prefixed() && f.prefixed(),
+        // id, schema id; topic, message encoding, metadata (a map of strings).
+        op::CHANNEL => f.skip(4) && f.prefixed() && f.prefixed() && f.string_map(),
+        // times, chunk offset and length; message index offsets (a map of fixed-size entries), their
+        // length; compression.
+        op::CHUNK_INDEX => f.skip(32) && f.prefixed() && f.skip(8) && f.prefixed(),
+        // Fixed fields, then the data: nothing prefixed.
+        _ => true,
+    }
+}
+
+/// The fields of a record not yet checked.
+struct Fields<'a>(&'a [u8]);
+
+impl Fields<'_> {
+    /// Passes `n` bytes, if there are.
+    fn skip(&mut self, n: usize) -> bool {
+        match self.0.get(n..) {
+            Some(rest) => {
+                self.0 = rest;
+                true
+            }
+            None => false,
+        }
+    }
+
+    /// The length of the `u32`-prefixed field that starts here.
+    fn len(&self) -> Option<usize> {
+        self.0.first_chunk::<4>().map(|b| u32::from_le_bytes(*b) as usize)
+    }
+
+    /// Passes a `u32`-prefixed field (a string, bytes, a map of fixed-size entries), if it fits.
+    fn prefixed(&mut self) -> bool {
+        self.len().is_some_and(|len| self.skip(4) && self.skip(len))
+    }
+
+    /// Passes a map of strings (its byte length, then key and value strings), if it and its entries fit.
+    fn string_map(&mut self) -> bool {
+        let Some(len) = self.len() else { return false };
+        let Some(entries) = self.0.get(4..).and_then(|rest| rest.get(..len)) else { return false };
+        let mut entries = Fields(entries);
+        while !entries.0.is_empty() {
+            if !(entries.prefixed() && entries.prefixed()) {
+                return false;
+            }
+        }
+        self.skip(4 + len)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `bytes` prefixed by their `u32` length.
+    fn prefixed(bytes: &[u8]) -> Vec<u8> {
+        [&(bytes.len() as u32).to_le_bytes()[..], bytes].concat()
+    }
+
+    #[test]
+    fn length_prefixes_must_lie_within_the_record() {
+        let channel = |metadata: &[u8]| -> Vec<u8> {
+            [&[1, 0, 1, 0][..], &prefixed(b"/scan"), &prefixed(b"cdr"), metadata].concat()
+        };
+        let entry = [prefixed(b"k"), prefixed(b"v")].concat();
+        assert!(prefixes_fit(op::CHANNEL, &channel(&prefixed(&entry))));
+        assert!(prefixes_fit(op::CHANNEL, &channel(&prefixed(b""))));
+        // A map longer than the record, or an entry's string longer than its map.
+        assert!(!prefixes_fit(op::CHANNEL, &channel(&u32::MAX.to_le_bytes())));
+        assert!(!prefixes_fit(op::CHANNEL, &channel(&prefixed(&[&entry[..], &[9, 0, 0, 0, b'x']].concat()))));
+        // A schema whose name claims 4 GiB, or cut inside its fixed fields.
+        let schema = [&[1, 0][..], &prefixed(b"sensor_msgs/msg/LaserScan"), &prefixed(b"ros2msg"), &prefixed(b"")];
+        assert!(prefixes_fit(op::SCHEMA, &schema.concat()));
+        assert!(!prefixes_fit(op::SCHEMA, &[&[1, 0][..], &u32::MAX.to_le_bytes(), b"name"].concat()));
+        assert!(!prefixes_fit(op::CHUNK_INDEX, &[0u8; 31]));
+        assert!(prefixes_fit(
+            op::CHUNK_INDEX,
+            &[&[0u8; 32][..], &prefixed(&[0; 10]), &[0; 8], &prefixed(b"zstd")].concat()
+        ));
+    }
 }

@@ -67,8 +67,9 @@ pub struct ReadOptions {
     /// Longest line a text log may have, bytes ([`MAX_LINE_BYTES`]): a longer one (a device, a binary file)
     /// is refused before it fills memory.
     pub max_line_bytes: usize,
-    /// Most bytes a log may hold once decompressed ([`MAX_LOG_BYTES`]): a larger one (an endless device, a
-    /// gzip bomb) is refused when it passes the bound, before it exhausts memory.
+    /// Most bytes a log may hold once decompressed ([`MAX_LOG_BYTES`]; a bag: its messages' bytes): a larger
+    /// one (an endless device, a gzip bomb, a bag of chunks that decompress to more) is refused when it
+    /// passes the bound, before it exhausts memory.
     pub max_bytes: u64,
     /// The topics and frame of a recorded bag.
     pub topics: TopicChoice,

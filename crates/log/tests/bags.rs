@@ -107,6 +107,22 @@ fn error(path: &Path, options: &ReadOptions) -> String {
 }
 
 #[test]
+fn a_bag_whose_messages_pass_the_byte_bound_is_refused() {
+    // The 10 s bags hold about 100 KB of messages (the compressed ones decompress to that): refused past
+    // 64 KB in every format, read whole under the default bound.
+    let small = ReadOptions { max_bytes: 65536, ..ReadOptions::default() };
+    for name in ["aces_10s_bz2.bag", "aces_10s.bag", "aces_10s_zstd.mcap", "aces_10s_sqlite3", "aces_10s_mcap"] {
+        let path = data(name);
+        let e = read_log(&path, &small).map(|_| ()).unwrap_err();
+        assert!(matches!(e, LogError::TooLarge { limit: 65536, .. }), "{name}: {e}");
+        // A folder's error names the file in it.
+        assert!(e.to_string().starts_with(&path.display().to_string()), "{e}");
+        assert!(e.to_string().contains(": more than 65536 bytes: refused before it exhausts memory"), "{e}");
+        assert!(read(&path).scans.len() > 10, "{name}");
+    }
+}
+
+#[test]
 fn truncated_bags_are_refused_naming_the_file_and_the_byte() {
     let dir = tempfile::tempdir().unwrap();
     for name in ["aces_10s_bz2.bag", "aces_10s.bag", "aces_10s_zstd.mcap", "aces_10s_mcap/aces_10s_mcap.mcap"] {
