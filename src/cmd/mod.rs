@@ -17,6 +17,7 @@ pub mod run_bag;
 pub mod run_folder;
 pub mod sim;
 pub mod sim_log;
+pub mod sim_progress;
 pub mod slam;
 pub mod slam_eta;
 pub mod study;

@@ -5,12 +5,10 @@ use super::run_bag::RunBag;
 use super::run_folder::{OwnOutput, RunFolder};
 use anyhow::{Result, bail};
 use clap::Args;
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use mrslam_merge::Algorithm;
 use mrslam_testbed::runner::{RobotStep, RunOptions, StepTap, output_files, run as run_scenario, write_outputs};
 use mrslam_testbed::scenario::Scenario;
 use mrslam_viz::RunRecorder;
-use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -85,24 +83,11 @@ pub fn run(args: RunArgs) -> Result<ExitCode> {
             .unwrap_or_default()
             + &bag.as_ref().map(RunBag::interrupted).unwrap_or_default()
     ));
-    let bar = ProgressBar::new((scenario.duration * 10.0) as u64);
-    if args.quiet || !std::io::stderr().is_terminal() {
-        bar.set_draw_target(ProgressDrawTarget::hidden());
-    }
-    bar.set_style(
-        ProgressStyle::with_template("{msg} [{bar:40}] {prefix} sim s, {elapsed} wall, ETA {eta}")
-            .expect("valid template")
-            .progress_chars("=> "),
-    );
-    bar.set_message(scenario.name.clone());
+    let bar = super::sim_progress::bar(&scenario.name, scenario.duration, args.quiet);
     let opts = RunOptions {
         algorithms,
         // The bar runs to the expected end of the run (a rendezvous usually comes long before the duration).
-        progress: Some(Box::new(|t: f64, end: f64| {
-            bar.set_length((end.max(t) * 10.0) as u64);
-            bar.set_position((t * 10.0) as u64);
-            bar.set_prefix(format!("{t:.0}/{end:.0}"));
-        })),
+        progress: Some(Box::new(|t: f64, end: f64| super::sim_progress::show(&bar, t, end))),
         viz: viz.as_mut(),
         on_step: bag.as_mut().map(|b| Box::new(|s: &RobotStep<'_>| b.step(s)) as StepTap),
     };

@@ -6,7 +6,6 @@ use super::outputs::{Outputs, kind};
 use super::run_bag::RunBag;
 use anyhow::{Context, Result, bail};
 use clap::Args;
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use mrslam_core::output::{AtomicFile, write_file_atomic};
 use mrslam_core::pose::interpolate;
 use mrslam_core::relations::{StampedPose, format_relations, format_trajectory};
@@ -17,7 +16,6 @@ use mrslam_testbed::runner::{RobotStep, RunOptions, run as run_scenario};
 use mrslam_testbed::scenario::Scenario;
 use serde_json::json;
 use std::collections::VecDeque;
-use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -137,16 +135,7 @@ pub fn run(args: LogArgs) -> Result<ExitCode> {
             history: VecDeque::new(),
         });
     }
-    let bar = ProgressBar::new((scenario.duration * 10.0) as u64);
-    if args.quiet || !std::io::stderr().is_terminal() {
-        bar.set_draw_target(ProgressDrawTarget::hidden());
-    }
-    bar.set_style(
-        ProgressStyle::with_template("{msg} [{bar:40}] {prefix} sim s, {elapsed} wall, ETA {eta}")
-            .expect("valid template")
-            .progress_chars("=> "),
-    );
-    bar.set_message(scenario.name.clone());
+    let bar = super::sim_progress::bar(&scenario.name, scenario.duration, args.quiet);
     let mut write_error: Option<anyhow::Error> = None;
     let odom_lines = !args.no_odom_lines;
     let tap = |s: &RobotStep<'_>| {
@@ -184,11 +173,7 @@ pub fn run(args: LogArgs) -> Result<ExitCode> {
     let opts = RunOptions {
         // A log needs no merge.
         algorithms: Some(Vec::new()),
-        progress: Some(Box::new(|t: f64, end: f64| {
-            bar.set_length((end.max(t) * 10.0) as u64);
-            bar.set_position((t * 10.0) as u64);
-            bar.set_prefix(format!("{t:.0}/{end:.0}"));
-        })),
+        progress: Some(Box::new(|t: f64, end: f64| super::sim_progress::show(&bar, t, end))),
         viz: None,
         on_step: Some(Box::new(tap)),
     };

@@ -5,18 +5,13 @@
 //! closure while driving) must close the loop on every seed, and the map it holds a few metres after the
 //! robot is back, before the log ends, must already be loop-closed.
 
-use crate::util::{mrslam, p, text};
+use crate::util::{mrslam, p, root, text};
 use mrslam_core::map_io::read_ros_map;
 use mrslam_core::relations::{Relation, StampedPose, read_relations, score};
 use mrslam_core::{CellState, OccupancyGrid, Pose2};
 use mrslam_log::{ReadOptions, read_log};
 use mrslam_slam::{Rbpf, SlamBackend, SlamParams, poses_at_every_scan};
 use nalgebra::Point2;
-use std::path::{Path, PathBuf};
-
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).to_path_buf()
-}
 
 /// Loop relations: drawn between scans far apart in time (the local ones span a metre, a few seconds).
 fn loop_relations(relations: &[Relation]) -> Vec<Relation> {

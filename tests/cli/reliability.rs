@@ -2,30 +2,8 @@
 //! maps with nothing in them. Nothing is overwritten, every error exits 1 and names what is wrong, and exit
 //! code 2 means only a refused merge.
 
-use crate::util::{mrslam, p, text};
-use mrslam_core::map_io::write_ros_map;
-use mrslam_merge::floorplan::{FloorplanParams, generate};
-use std::path::{Path, PathBuf};
-use std::process::Output;
-
-/// Runs `args`, expects exit 1 and a message with every needle, and no panic.
-fn fails_with(args: &[&str], needles: &[&str]) -> Output {
-    let o = mrslam(args);
-    let e = text(&o.stderr);
-    assert_eq!(o.status.code(), Some(1), "exit code of {args:?}; stdout {} stderr {e}", text(&o.stdout));
-    assert!(!e.contains("panicked"), "{e}");
-    for n in needles {
-        assert!(e.contains(n), "stderr of {args:?} lacks `{n}`: {e}");
-    }
-    o
-}
-
-/// A generated floor plan written as `name`.yaml + .pgm in `dir`.
-fn plan(dir: &Path, name: &str, seed: u64) -> PathBuf {
-    let path = dir.join(format!("{name}.yaml"));
-    write_ros_map(&generate(seed, &FloorplanParams::default()), &path).unwrap();
-    path
-}
+use crate::util::{fails_with, mrslam, p, plan, text};
+use std::path::Path;
 
 /// The bytes of every file in `dir`, by name.
 fn snapshot(dir: &Path) -> Vec<(String, Vec<u8>)> {

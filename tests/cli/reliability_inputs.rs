@@ -2,33 +2,9 @@
 //! negative numbers refused by their own checks, files of the wrong kind refused, and help that says what the
 //! commands do.
 
-use crate::util::{mrslam, p, text};
+use crate::util::{fails_with, mrslam, p, plan, root, text};
 use mrslam_core::map_io::write_ros_map;
 use mrslam_merge::floorplan::{FloorplanParams, generate};
-use std::path::{Path, PathBuf};
-
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
-
-/// Runs `args`, expects exit 1 and a message with every needle, and no panic.
-fn fails_with(args: &[&str], needles: &[&str]) -> String {
-    let o = mrslam(args);
-    let e = text(&o.stderr);
-    assert_eq!(o.status.code(), Some(1), "exit code of {args:?}; stdout {} stderr {e}", text(&o.stdout));
-    assert!(!e.contains("panicked"), "{e}");
-    for n in needles {
-        assert!(e.contains(n), "stderr of {args:?} lacks `{n}`: {e}");
-    }
-    e
-}
-
-/// A generated floor plan written as `name`.yaml + .pgm in `dir`.
-fn plan(dir: &Path, name: &str, seed: u64) -> PathBuf {
-    let path = dir.join(format!("{name}.yaml"));
-    write_ros_map(&generate(seed, &FloorplanParams::default()), &path).unwrap();
-    path
-}
 
 #[test]
 fn devices_are_refused_before_they_fill_memory() {
@@ -61,9 +37,12 @@ fn absurd_and_negative_numbers_get_their_own_checks() {
     cut(&["--max-shift", "1e9"], &["--max-shift 1000000000", "0..=1000"]);
     cut(&["--seed", "-1"], &["invalid value '-1' for '--seed <SEED>'"]);
     assert!(!a.exists() && !b.exists());
-    let e = fails_with(
-        &["world", "from-map", p(&w), "-o", p(&d.join("w.toml")), "--clearance", "-1"],
-        &["--clearance -1", "must be a positive number"],
+    let e = text(
+        &fails_with(
+            &["world", "from-map", p(&w), "-o", p(&d.join("w.toml")), "--clearance", "-1"],
+            &["--clearance -1", "must be a positive number"],
+        )
+        .stderr,
     );
     assert!(!e.contains("-- -1"), "{e}");
     fails_with(&["run", "scenarios/paper_two_rooms.toml", "--seed", "-1"], &["invalid value '-1' for '--seed"]);

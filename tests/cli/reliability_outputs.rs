@@ -2,27 +2,11 @@
 //! by one rule before any work; `run --out DIR` replaces or removes only the files it made; an interrupted run
 //! leaves its folder as it was and says so; a map merged with itself is refused.
 
-use crate::util::{mrslam, p, text};
+use crate::util::{fails_with, mrslam, p, root, text};
 use mrslam_core::map_io::write_ros_map;
 use mrslam_merge::floorplan::{FloorplanParams, generate};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output, Stdio};
-
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
-
-/// Runs `args`, expects exit 1 and a message with every needle, and no panic.
-fn fails_with(args: &[&str], needles: &[&str]) -> Output {
-    let o = mrslam(args);
-    let e = text(&o.stderr);
-    assert_eq!(o.status.code(), Some(1), "exit code of {args:?}; stdout {} stderr {e}", text(&o.stdout));
-    assert!(!e.contains("panicked"), "{e}");
-    for n in needles {
-        assert!(e.contains(n), "stderr of {args:?} lacks `{n}`: {e}");
-    }
-    o
-}
+use std::process::{Command, Stdio};
 
 /// The names of the files in `dir`, sorted.
 fn names(dir: &Path) -> Vec<String> {

@@ -1,11 +1,7 @@
 //! `mrslam run`, as a user would: bad scenarios are refused with the file, line and field named.
 
-use crate::util::mrslam;
+use crate::util::{mrslam, root};
 use std::path::{Path, PathBuf};
-
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
 
 /// The two-rooms scenario with one line replaced, written next to the shipped one's world path.
 fn variant(dir: &Path, name: &str, from: &str, to: &str) -> PathBuf {

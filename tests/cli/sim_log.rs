@@ -1,12 +1,8 @@
 //! `mrslam sim log`: a simulated run written as benchmark data (a CARMEN log per robot, its true trajectory,
 //! relations drawn from the truth) that `mrslam eval` and `mrslam slam` read as they read the real benchmark.
 
-use crate::util::{mrslam, p, text};
+use crate::util::{mrslam, p, root, text};
 use std::path::{Path, PathBuf};
-
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).to_path_buf()
-}
 
 /// Two robots of the two-rooms world, each driving its room's loop twice.
 fn scenario(dir: &Path) -> PathBuf {

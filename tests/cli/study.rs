@@ -1,12 +1,8 @@
 //! `mrslam study`, as a user would: a small map-level study, its files, its shards, and bad input.
 
-use crate::util::mrslam;
-use std::path::{Path, PathBuf};
+use crate::util::{mrslam, root};
+use std::path::Path;
 use std::process::{Command, Output};
-
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
 
 const COLUMNS: &str = "trial,overlap_target,overlap,seed,algorithm,accepted,success,false_merge,rotation_error_deg,\
 translation_error_m,time_ms,rotation_error_at_end_deg,translation_error_at_end_m,stage";

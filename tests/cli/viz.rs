@@ -3,16 +3,12 @@
 //! plausible counts, an RRD footer with a manifest per store, the same content on a second run; bad destinations
 //! must fail before any work, and an interrupted run must leave nothing under the recording's name.
 
-use crate::util::{mrslam, p, text};
+use crate::util::{mrslam, p, root, text};
 use mrslam_core::map_io::write_ros_map;
 use mrslam_merge::floorplan::{FloorplanParams, generate};
 use mrslam_viz::inspect::{first_difference, summarize};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
-
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
 
 /// The two-rooms scenario cut to `seconds` of simulated time and the SIFT merge only, written into `dir`.
 fn short_scenario(dir: &Path, seconds: f64) -> PathBuf {
