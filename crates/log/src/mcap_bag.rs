@@ -9,9 +9,11 @@
 //! 4 GiB for a chunk whose compression name claims it), and only the records the log needs (schemas,
 //! channels, messages, chunk indexes) are parsed, once their length prefixes are checked against the
 //! record ([`prefixes_fit`]): `mcap::parse_record` reserves what a string's prefix claims before reading it.
+//! A third keeps the crate from walking past an uncompressed chunk: `mcap_frames` checks its records' framing.
 
 use crate::bag_messages::{BagMessages, MAX_RECORD_BYTES, Wire};
 use crate::error::LogError;
+use crate::mcap_frames::McapFrames;
 use mcap::records::{Record, op};
 use mcap::sans_io::linear_reader::{LinearReadEvent, LinearReader, LinearReaderOptions};
 use std::collections::{BTreeMap, BTreeSet};
@@ -31,7 +33,9 @@ struct Channel {
 }
 
 /// Reads an MCAP file from `r` into `bag`; returns the format's name for summaries.
-pub(crate) fn read(mut r: impl Read, bag: &mut BagMessages) -> Result<String, LogError> {
+pub(crate) fn read(r: impl Read, bag: &mut BagMessages) -> Result<String, LogError> {
+    // The framing of uncompressed chunks checked before the crate walks them (see `mcap_frames`).
+    let mut r = McapFrames::new(r);
     let options =
         LinearReaderOptions::default().with_prevalidate_chunk_crcs(true).with_record_length_limit(MAX_RECORD_BYTES);
     let mut reader = LinearReader::new_with_options(options);
