@@ -10,6 +10,8 @@
 //! channels, messages, chunk indexes) are parsed, once their length prefixes are checked against the
 //! record ([`prefixes_fit`]): `mcap::parse_record` reserves what a string's prefix claims before reading it.
 //! A third keeps the crate from walking past an uncompressed chunk: `mcap_frames` checks its records' framing.
+//! A fourth keeps it from spinning forever on a compressed chunk that holds less than it declares: each
+//! chunk is read by a reader of its own that sees nothing past the chunk ([`read_chunk`]).
 
 use crate::bag_messages::{BagMessages, MAX_RECORD_BYTES, Wire};
 use crate::error::LogError;
@@ -17,13 +19,18 @@ use crate::mcap_frames::McapFrames;
 use mcap::records::{Record, op};
 use mcap::sans_io::linear_reader::{LinearReadEvent, LinearReader, LinearReaderOptions};
 use std::collections::{BTreeMap, BTreeSet};
+use std::fmt;
 use std::io::Read;
+use std::path::Path;
 
 /// The first bytes of an MCAP file.
 pub(crate) const MAGIC: &[u8] = b"\x89MCAP0\r\n";
 
 /// The most bytes handed to the reader at a time.
 const READ_BYTES: usize = 1 << 20;
+
+/// A record's opcode and length: one byte and a little-endian u64.
+const RECORD_HEADER: usize = 9;
 
 /// A channel: its topic, its schema's name and its message encoding.
 struct Channel {
@@ -32,25 +39,102 @@ struct Channel {
     encoding: String,
 }
 
+/// Where a record lies, for errors.
+#[derive(Clone, Copy)]
+enum Place {
+    /// Outside chunks, within the first this many bytes of the file (those handed to the reader).
+    Within(u64),
+    /// In the chunk record at this byte.
+    Chunk(u64),
+}
+
+impl fmt::Display for Place {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Place::Within(fed) => write!(f, "within the first {fed} bytes"),
+            Place::Chunk(at) => write!(f, "the chunk at byte {at}"),
+        }
+    }
+}
+
+/// An error of the `mcap` crate's reader at `place` of the file at `path`.
+fn mcap_err(path: &Path, place: Place, e: mcap::McapError) -> LogError {
+    let cut = matches!(place, Place::Within(_))
+        && matches!(e, mcap::McapError::UnexpectedEof | mcap::McapError::UnexpectedEoc);
+    let hint = if cut { " (cut off: a truncated download or copy?)" } else { "" };
+    LogError::Bag { path: path.to_path_buf(), message: format!("MCAP, {place}: {e}{hint}") }
+}
+
+/// What the records read so far define, and the bag their messages go to.
+struct Records<'a> {
+    bag: &'a mut BagMessages,
+    schemas: BTreeMap<u16, String>,
+    channels: BTreeMap<u16, Channel>,
+    compressions: BTreeSet<String>,
+}
+
+impl Records<'_> {
+    /// Takes the record `opcode` with body `data`, at `place`.
+    fn take(&mut self, opcode: u8, data: &[u8], place: Place) -> Result<(), LogError> {
+        if !matches!(opcode, op::SCHEMA | op::CHANNEL | op::MESSAGE | op::CHUNK_INDEX) {
+            return Ok(());
+        }
+        if !prefixes_fit(opcode, data) {
+            return Err(self
+                .bag
+                .error(format!("MCAP, {place}: a record (opcode {opcode:#04x}) whose fields run past its end")));
+        }
+        let record = mcap::parse_record(opcode, data).map_err(|e| mcap_err(&self.bag.path, place, e))?;
+        match record {
+            Record::Schema { header, .. } => {
+                self.schemas.insert(header.id, header.name);
+            }
+            Record::Channel(c) => {
+                let type_name = self.schemas.get(&c.schema_id).cloned().unwrap_or_default();
+                self.channels.insert(c.id, Channel { topic: c.topic, type_name, encoding: c.message_encoding });
+            }
+            Record::ChunkIndex(index) => {
+                self.compressions.insert(index.compression);
+            }
+            Record::Message { header, data } => {
+                let Some(c) = self.channels.get(&header.channel_id) else {
+                    return Err(self.bag.error(format!(
+                        "MCAP, {place}: a message on channel {}, which no record defines",
+                        header.channel_id
+                    )));
+                };
+                let bag = &mut *self.bag;
+                match c.encoding.as_str() {
+                    "cdr" => bag.add(&c.topic, &c.type_name, Wire::Cdr, header.log_time, &data)?,
+                    "ros1" => bag.add(&c.topic, &c.type_name, Wire::Ros1, header.log_time, &data)?,
+                    // Counted, not decoded: an encoding (json, protobuf) no ROS bag uses.
+                    other => {
+                        let type_name = format!("{} ({other})", c.type_name);
+                        bag.add(&c.topic, &type_name, Wire::Cdr, header.log_time, &[])?
+                    }
+                }
+            }
+            _ => {}
+        }
+        Ok(())
+    }
+}
+
 /// Reads an MCAP file from `r` into `bag`; returns the format's name for summaries.
 pub(crate) fn read(r: impl Read, bag: &mut BagMessages) -> Result<String, LogError> {
     // The framing of uncompressed chunks checked before the crate walks them (see `mcap_frames`).
     let mut r = McapFrames::new(r);
-    let options =
-        LinearReaderOptions::default().with_prevalidate_chunk_crcs(true).with_record_length_limit(MAX_RECORD_BYTES);
+    // Chunks are yielded whole, each read by a reader of its own (see `read_chunk`).
+    let options = LinearReaderOptions::default().with_emit_chunks(true).with_record_length_limit(MAX_RECORD_BYTES);
     let mut reader = LinearReader::new_with_options(options);
-    let mut schemas: BTreeMap<u16, String> = BTreeMap::new();
-    let mut channels: BTreeMap<u16, Channel> = BTreeMap::new();
-    let mut compressions = BTreeSet::new();
-    let mut fed: u64 = 0;
     let path = bag.path.clone();
-    let mcap_err = |fed: u64, e: mcap::McapError| {
-        let cut = matches!(e, mcap::McapError::UnexpectedEof | mcap::McapError::UnexpectedEoc);
-        let hint = if cut { " (cut off: a truncated download or copy?)" } else { "" };
-        LogError::Bag { path: path.clone(), message: format!("MCAP, within the first {fed} bytes: {e}{hint}") }
-    };
+    let mut records =
+        Records { bag, schemas: BTreeMap::new(), channels: BTreeMap::new(), compressions: BTreeSet::new() };
+    let mut fed: u64 = 0;
+    // Where the next record starts: the reader yields every record of the file (chunks whole), in order.
+    let mut next_at = MAGIC.len() as u64;
     while let Some(event) = reader.next_event() {
-        match event.map_err(|e| mcap_err(fed, e))? {
+        match event.map_err(|e| mcap_err(&path, Place::Within(fed), e))? {
             LinearReadEvent::ReadRequest(need) => {
                 let n = r
                     .read(reader.insert(need.min(READ_BYTES)))
@@ -59,51 +143,87 @@ pub(crate) fn read(r: impl Read, bag: &mut BagMessages) -> Result<String, LogErr
                 fed += n as u64;
             }
             LinearReadEvent::Record { opcode, data } => {
-                if !matches!(opcode, op::SCHEMA | op::CHANNEL | op::MESSAGE | op::CHUNK_INDEX) {
-                    continue;
-                }
-                if !prefixes_fit(opcode, data) {
-                    return Err(bag.error(format!(
-                        "MCAP, within the first {fed} bytes: a record (opcode {opcode:#04x}) whose fields run past its end"
-                    )));
-                }
-                let record = mcap::parse_record(opcode, data).map_err(|e| mcap_err(fed, e))?;
-                match record {
-                    Record::Schema { header, .. } => {
-                        schemas.insert(header.id, header.name);
-                    }
-                    Record::Channel(c) => {
-                        let type_name = schemas.get(&c.schema_id).cloned().unwrap_or_default();
-                        channels.insert(c.id, Channel { topic: c.topic, type_name, encoding: c.message_encoding });
-                    }
-                    Record::ChunkIndex(index) => {
-                        compressions.insert(index.compression);
-                    }
-                    Record::Message { header, data } => {
-                        let Some(c) = channels.get(&header.channel_id) else {
-                            return Err(bag.error(format!(
-                                "MCAP, within the first {fed} bytes: a message on channel {}, which no record defines",
-                                header.channel_id
-                            )));
-                        };
-                        match c.encoding.as_str() {
-                            "cdr" => bag.add(&c.topic, &c.type_name, Wire::Cdr, header.log_time, &data)?,
-                            "ros1" => bag.add(&c.topic, &c.type_name, Wire::Ros1, header.log_time, &data)?,
-                            // Counted, not decoded: an encoding (json, protobuf) no ROS bag uses.
-                            other => {
-                                let type_name = format!("{} ({other})", c.type_name);
-                                bag.add(&c.topic, &type_name, Wire::Cdr, header.log_time, &[])?
-                            }
-                        }
-                    }
-                    _ => {}
+                let at = next_at;
+                next_at += (RECORD_HEADER + data.len()) as u64;
+                if opcode == op::CHUNK {
+                    read_chunk(at, data, &mut records)?;
+                } else {
+                    records.take(opcode, data, Place::Within(fed))?;
                 }
             }
         }
     }
     let kinds: Vec<String> =
-        compressions.into_iter().map(|c| if c.is_empty() { "uncompressed".to_string() } else { c }).collect();
+        records.compressions.into_iter().map(|c| if c.is_empty() { "uncompressed".to_string() } else { c }).collect();
     Ok(if kinds.is_empty() { "MCAP".to_string() } else { format!("MCAP ({} chunks)", kinds.join(" and ")) })
+}
+
+/// Reads the records of the chunk whose record, at byte `at` of the file, has body `body`.
+///
+/// Each chunk is handed to a reader of its own: its header and compressed records only (any bytes after them
+/// in the record dropped), then the end of the input. Why: the crate's decompression loop
+/// (`decompress_inner`) feeds the decompressor the chunk's compressed bytes not yet read, and asks for more
+/// input only when its buffer holds fewer than the decompressor wants; once a chunk's compressed data is
+/// used up short of the uncompressed size the chunk declares, it feeds the decompressor nothing, forever, as
+/// long as its buffer holds bytes from past the chunk (found by fuzzing: a zstd chunk declaring 1.3 MB and
+/// holding 119 KB). A reader that holds nothing past the chunk asks for more instead, is told the input
+/// ends, and fails. Cheaper than checking each chunk first, which would decompress it twice; the records of
+/// an uncompressed chunk still go through `mcap_frames` first, as part of the file.
+fn read_chunk(at: u64, body: &[u8], records: &mut Records) -> Result<(), LogError> {
+    let path = records.bag.path.clone();
+    let err =
+        |what: &str| LogError::Bag { path: path.clone(), message: format!("MCAP, the chunk at byte {at}: {what}") };
+    let Some((declared, compressed, chunk)) = chunk_parts(body) else {
+        return Err(err("its fields run past the end of its record"));
+    };
+    let options = LinearReaderOptions::default()
+        .with_skip_start_magic(true)
+        .with_skip_end_magic(true)
+        .with_prevalidate_chunk_crcs(true)
+        .with_record_length_limit(MAX_RECORD_BYTES);
+    let mut reader = LinearReader::new_with_options(options);
+    let mut input = Some(chunk);
+    while let Some(event) = reader.next_event() {
+        match event {
+            // The chunk as a record of its own, then the end of the input.
+            Ok(LinearReadEvent::ReadRequest(_)) => match input.take() {
+                Some(chunk) => {
+                    let buf = reader.insert(RECORD_HEADER + chunk.len());
+                    buf[0] = op::CHUNK;
+                    buf[1..RECORD_HEADER].copy_from_slice(&(chunk.len() as u64).to_le_bytes());
+                    buf[RECORD_HEADER..].copy_from_slice(chunk);
+                    reader.notify_read(RECORD_HEADER + chunk.len());
+                }
+                None => reader.notify_read(0),
+            },
+            Ok(LinearReadEvent::Record { opcode, data }) => records.take(opcode, data, Place::Chunk(at))?,
+            Err(mcap::McapError::UnexpectedEof) if compressed => {
+                return Err(err(&format!(
+                    "its compressed data holds fewer bytes than the uncompressed size it declares ({declared} bytes)"
+                )));
+            }
+            Err(mcap::McapError::UnexpectedEof) => return Err(err("its records run past its end")),
+            Err(e) => return Err(mcap_err(&path, Place::Chunk(at), e)),
+        }
+    }
+    Ok(())
+}
+
+/// The uncompressed size a chunk record's `body` declares, whether the chunk is compressed, and its header
+/// and records (without any bytes after them in the record); `None` if they run past the record.
+fn chunk_parts(body: &[u8]) -> Option<(u64, bool, &[u8])> {
+    let mut f = Fields(body);
+    // Start and end time, uncompressed size, CRC, compression, the records' length.
+    f.u64()?;
+    f.u64()?;
+    let declared = f.u64()?;
+    let compression = f.skip(4).then(|| f.len()).flatten()?;
+    if !f.prefixed() {
+        return None;
+    }
+    let records = usize::try_from(f.u64()?).ok()?;
+    let end = (body.len() - f.0.len()).checked_add(records)?;
+    Some((declared, compression > 0, body.get(..end)?))
 }
 
 /// Whether the length-prefixed fields of a schema, channel or chunk index record (strings, maps, the
@@ -136,6 +256,13 @@ impl Fields<'_> {
             }
             None => false,
         }
+    }
+
+    /// Passes a little-endian `u64`, if there is one.
+    fn u64(&mut self) -> Option<u64> {
+        let value = u64::from_le_bytes(*self.0.first_chunk::<8>()?);
+        self.skip(8);
+        Some(value)
     }
 
     /// The length of the `u32`-prefixed field that starts here.

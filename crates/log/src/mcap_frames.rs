@@ -4,7 +4,8 @@
 //! Why: the crate's linear reader walks an uncompressed chunk's records straight from the stream, subtracting
 //! each record's claimed length from what is left of the chunk; a record that claims to run past the chunk's
 //! end overflows that subtraction (a panic where overflow checks are on, a reader that wanders past the chunk
-//! where they are off). Found by fuzzing (`mcap_bag`). Compressed chunks are checked by the crate itself.
+//! where they are off). Found by fuzzing (`mcap_bag`). Compressed chunks are checked by the crate itself as it
+//! decompresses them, each by a reader that sees nothing past the chunk (`mcap_bag::read_chunk`).
 
 use std::io::{self, Read};
 

@@ -165,7 +165,62 @@ fn a_chunk_that_does_not_decompress_is_refused_naming_its_offset() {
     let bad = dir.path().join("bad.mcap");
     std::fs::write(&bad, &bytes).unwrap();
     let e = error(&bad, &ReadOptions::default());
-    assert!(e.starts_with(&format!("{}: MCAP, within the first", bad.display())), "{e}");
+    assert!(e.starts_with(&format!("{}: MCAP, the chunk at byte ", bad.display())), "{e}");
+}
+
+/// An MCAP file written by the `mcap` crate: one `compression` chunk holding a channel and 20 messages, the
+/// chunk's declared uncompressed size grown by `more` bytes; with the chunk's byte offset.
+fn mcap_chunk_declaring_more(compression: mcap::Compression, more: u64) -> (Vec<u8>, usize) {
+    let out = std::io::Cursor::new(Vec::new());
+    let mut w = mcap::WriteOptions::new().compression(Some(compression)).create(out).unwrap();
+    let schema = w.add_schema("std_msgs/msg/String", "ros2msg", b"string data").unwrap();
+    let channel = w.add_channel(schema, "/chatter", "cdr", &Default::default()).unwrap();
+    for k in 0..20 {
+        let header =
+            mcap::records::MessageHeader { channel_id: channel, sequence: k, log_time: k.into(), publish_time: 0 };
+        w.write_to_known_channel(&header, &[7; 100]).unwrap();
+    }
+    w.finish().unwrap();
+    let mut bytes = w.into_inner().into_inner();
+    // Past the magic, records (opcode, u64 length) up to the chunk; its uncompressed size 16 bytes in.
+    let mut at = 8;
+    while bytes[at] != 0x06 {
+        at += 9 + u64::from_le_bytes(bytes[at + 1..at + 9].try_into().unwrap()) as usize;
+    }
+    let size = at + 9 + 16;
+    let declared = u64::from_le_bytes(bytes[size..size + 8].try_into().unwrap());
+    bytes[size..size + 8].copy_from_slice(&(declared + more).to_le_bytes());
+    (bytes, at)
+}
+
+#[test]
+fn a_compressed_chunk_declaring_more_than_it_holds_is_refused_naming_its_offset() {
+    // The `mcap` crate's reader once spun forever on such a chunk (found by fuzzing): each read runs on a
+    // thread of its own, and one that takes long fails the test.
+    let dir = tempfile::tempdir().unwrap();
+    for (name, compression) in [("zstd.mcap", mcap::Compression::Zstd), ("lz4.mcap", mcap::Compression::Lz4)] {
+        // As written, the file reads: it has no scan.
+        let (bytes, _) = mcap_chunk_declaring_more(compression, 0);
+        let path = dir.path().join(name);
+        std::fs::write(&path, &bytes).unwrap();
+        assert!(error(&path, &ReadOptions::default()).contains("no sensor_msgs/LaserScan topic"), "{name}");
+        for more in [1, 1 << 20] {
+            let (bytes, at) = mcap_chunk_declaring_more(compression, more);
+            std::fs::write(&path, &bytes).unwrap();
+            let (done, result) = std::sync::mpsc::channel();
+            let read = path.clone();
+            std::thread::spawn(move || done.send(error(&read, &ReadOptions::default())));
+            let e = result
+                .recv_timeout(std::time::Duration::from_secs(60))
+                .unwrap_or_else(|_| panic!("{name}, {more} more bytes declared: still reading after 60 s"));
+            let expected = format!(
+                "{}: MCAP, the chunk at byte {at}: its compressed data holds fewer bytes than the uncompressed size \
+                 it declares",
+                path.display()
+            );
+            assert!(e.starts_with(&expected), "{name}, {more} more bytes declared: {e}");
+        }
+    }
 }
 
 /// A ROS 1 bag written here: one uncompressed chunk of `messages` (topic, type, serialized message).

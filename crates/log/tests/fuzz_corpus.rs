@@ -25,7 +25,8 @@ fn carmen_log_corpus() {
 }
 
 /// Replays the corpus of a bag target as the target does (each input written to a file named `.ext`, then
-/// `read_log`); the seeds (`seed-*`, cut from tests/data/bags) must read into logs with scans.
+/// `read_log`); the seeds (`seed-*`, cut from tests/data/bags) must read into logs with scans, the inputs that
+/// found a bug (`crash-*`: a panic, an allocation of what a header claims, a hang) must be refused.
 fn bag_corpus(target: &str, ext: &str) {
     let dir = tempfile::tempdir().unwrap();
     let file = dir.path().join(format!("input.{ext}"));
@@ -38,6 +39,8 @@ fn bag_corpus(target: &str, ext: &str) {
             let log = read.unwrap_or_else(|e| panic!("{name}: {e}"));
             assert!(log.scans.len() > 5 && !log.odometry.is_empty(), "{name}: {} scans", log.scans.len());
             seeds += 1;
+        } else if name.starts_with("crash-") {
+            assert!(read.is_err(), "{name}: read");
         }
     }
     assert!(seeds > 0, "{target}: no seed");
