@@ -311,6 +311,7 @@ pub fn run(args: SlamArgs) -> Result<ExitCode> {
     let duration = stamps[stamps.len() - 1] - stamps[0];
     let realtime = if secs > 0.0 { duration / secs } else { f64::INFINITY };
     let peak = super::peak_memory_bytes();
+    let mem = filter.memory_stats();
     println!("log: {} ({:.1} s); {}", args.log.display(), duration, log.repairs.describe());
     println!("odometry: {}", log.repairs.describe_odometry());
     if let Some(worst) = jumps.iter().max_by(|a, b| a.distance.total_cmp(&b.distance)) {
@@ -389,6 +390,13 @@ pub fn run(args: SlamArgs) -> Result<ExitCode> {
             "real_time_factor": realtime,
             "ms_per_scan": secs * 1e3 / c.readings.max(1) as f64,
             "peak_memory_bytes": peak,
+            "held_at_end": {
+                "map_tiles": mem.unique_tiles,
+                "map_tile_bytes": mem.tile_bytes,
+                "map_tile_bytes_unshared": mem.unshared_tile_bytes,
+                "trajectory_bytes": mem.trajectory_bytes,
+                "loop_graph_bytes": mem.loop_graph_bytes,
+            },
             "repairs": {
                 "out_of_order": r.out_of_order,
                 "max_step_back_s": r.max_step_back,

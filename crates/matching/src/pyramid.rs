@@ -27,6 +27,11 @@ impl PooledGrid {
         if sx < self.width && sy < self.height { self.values[(sy * self.width + sx) as usize] } else { 0 }
     }
 
+    /// Heap bytes of the values.
+    pub fn bytes(&self) -> usize {
+        self.values.capacity() * std::mem::size_of::<i16>()
+    }
+
     /// Sum of the values at `points` displaced by (`ox`, `oy`).
     #[inline]
     pub fn score(&self, points: &[(i32, i32)], ox: i32, oy: i32) -> i64 {

@@ -121,7 +121,7 @@ fn memory(_c: &mut Criterion) {
         m.unique_tiles,
         m.tile_bytes as f64 / 1e6,
         m.referenced_tiles,
-        m.unshared_tile_bytes() as f64 / 1e6,
+        m.unshared_tile_bytes as f64 / 1e6,
         m.slot_bytes as f64 / 1e6,
         m.trajectory_nodes,
         m.trajectory_bytes as f64 / 1e6,

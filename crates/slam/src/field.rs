@@ -20,7 +20,7 @@
 //! axis), so that near a corner a beam is measured to both faces and takes the nearer, as GMapping's kernel
 //! search takes the nearest mean around the end point itself.
 //!
-//! The tiles record which side each cell's hits came from ([`crate::tile_map::Tile::dir`]); a surfel whose
+//! The tiles record which side each cell's hits came from ([`crate::tile_map::CellHits::dir`]); a surfel whose
 //! beams all came from one side is *oriented*, and a beam can only end on it travelling against its normal.
 //! Without this test a surface just coming out of a pillar's shadow gets matched to the pillar's far face.
 //!
@@ -396,11 +396,10 @@ impl Field {
                     while bits != 0 {
                         let ix = bx + bits.trailing_zeros() as i32;
                         bits &= bits - 1;
-                        let l = local(ix, iy);
-                        let m = tile.mean[l];
-                        let mx = ((ix - cx0) as f64 * delta + m[0] as f64) as f32;
-                        let my = ((iy - cy0) as f64 * delta + m[1] as f64) as f32;
-                        self.occupied.push((ix - px0, iy - py0, mx, my, tile.hits[l] as u32, tile.dir[l]));
+                        let Some(c) = tile.cell(local(ix, iy)) else { continue };
+                        let mx = ((ix - cx0) as f64 * delta + c.mean[0] as f64) as f32;
+                        let my = ((iy - cy0) as f64 * delta + c.mean[1] as f64) as f32;
+                        self.occupied.push((ix - px0, iy - py0, mx, my, c.hits as u32, c.dir));
                         self.occ[((iy - py0) * pw + (ix - px0)) as usize] = self.occupied.len() as u32;
                     }
                 }

@@ -13,7 +13,7 @@ use crate::particle::{Particle, TrajectoryNode, ancestry};
 use crate::resample::{normalize, systematic};
 use crate::scan_matcher::{Beam, MatchInformation, MatchResult, MotionPrior, PreparedScan, ScanMatcher, Scratch};
 use crate::scan_odometry::ScanOdometry;
-use crate::tile_map::{TileMap, TooLarge};
+use crate::tile_map::{Tile, TileMap, TooLarge};
 use mrslam_core::{LaserScan, OccupancyGrid, Odometry, Pose2};
 use mrslam_core::{Xyt, pose::relative};
 use rand::{Rng, SeedableRng};
@@ -49,22 +49,22 @@ pub struct MemoryStats {
     pub referenced_tiles: usize,
     /// Bytes of the distinct tiles.
     pub tile_bytes: usize,
+    /// Bytes the maps would take without sharing (the referenced tiles' bytes).
+    pub unshared_tile_bytes: usize,
     /// Bytes of the particles' tile-pointer arrays.
     pub slot_bytes: usize,
     /// Distinct trajectory nodes.
     pub trajectory_nodes: usize,
     /// Bytes of the distinct trajectory nodes and their scans.
     pub trajectory_bytes: usize,
+    /// Bytes of the online loop closure's graph: its nodes and scans, edges and cached submap grids.
+    pub loop_graph_bytes: usize,
 }
 
 impl MemoryStats {
     /// All bytes counted.
     pub fn total_bytes(&self) -> usize {
-        self.tile_bytes + self.slot_bytes + self.trajectory_bytes
-    }
-    /// Bytes the maps would take without sharing.
-    pub fn unshared_tile_bytes(&self) -> usize {
-        self.referenced_tiles * crate::tile_map::Tile::BYTES
+        self.tile_bytes + self.slot_bytes + self.trajectory_bytes + self.loop_graph_bytes
     }
 }
 
@@ -619,18 +619,15 @@ impl Rbpf {
             .ok_or_else(|| SlamError::MapTooLarge("the trajectory's map exceeds core's grid size limit".into()))
     }
 
-    /// Memory held by the particles' maps and trajectories, counting shared tiles and nodes once.
+    /// Memory held by the particles' maps and trajectories and the loop graph, counting shared tiles and nodes once.
     pub fn memory_stats(&self) -> MemoryStats {
-        let mut tiles: Vec<usize> = Vec::new();
-        let mut referenced = 0;
+        let mut tiles: Vec<(usize, usize)> = Vec::new();
         let mut slots = 0;
         for p in &self.particles {
             slots += p.map.tile_slots();
-            for t in p.map.tile_ptrs() {
-                tiles.push(t as usize);
-                referenced += 1;
-            }
+            tiles.extend(p.map.tiles().map(|t| (t as *const Tile as usize, t.bytes())));
         }
+        let (referenced, unshared_tile_bytes) = (tiles.len(), tiles.iter().map(|t| t.1).sum());
         tiles.sort_unstable();
         tiles.dedup();
         let mut nodes = std::collections::BTreeSet::new();
@@ -650,10 +647,12 @@ impl Rbpf {
             particles: self.particles.len(),
             unique_tiles: tiles.len(),
             referenced_tiles: referenced,
-            tile_bytes: tiles.len() * crate::tile_map::Tile::BYTES,
-            slot_bytes: slots * std::mem::size_of::<Option<Arc<crate::tile_map::Tile>>>(),
+            tile_bytes: tiles.iter().map(|t| t.1).sum(),
+            unshared_tile_bytes,
+            slot_bytes: slots * std::mem::size_of::<Option<Arc<Tile>>>(),
             trajectory_nodes: nodes.len(),
             trajectory_bytes: nodes.len() * std::mem::size_of::<TrajectoryNode>() + scan_bytes,
+            loop_graph_bytes: self.graph.as_ref().map_or(0, LoopGraph::bytes),
         }
     }
 }

@@ -10,7 +10,8 @@
 //! score needs exactly these: a cell is "occupied" when it has hits, "free" when it has none, and the
 //! distance is measured to the mean of the hits, which is sub-cell accurate. Misses (free space) are not
 //! traced per particle, which keeps an update cheap; the output map ([`crate::map_build`]) traces them
-//! along the best particle's trajectory.
+//! along the best particle's trajectory. Only the cells with hits hold statistics ([`Tile`]): a building's map
+//! is mostly free and unknown cells.
 //!
 //! Cell `(ix, iy)` covers `[ix·delta, (ix+1)·delta) × [iy·delta, (iy+1)·delta)` of the map frame; indices may be
 //! negative.
@@ -22,7 +23,6 @@ pub const TILE_SHIFT: i32 = 5;
 /// Tile edge in cells (32).
 pub const TILE: i32 = 1 << TILE_SHIFT;
 const TILE_MASK: i32 = TILE - 1;
-const TILE_CELLS: usize = (TILE * TILE) as usize;
 /// Tiles added on each side when the tile array grows.
 const GROW_MARGIN: i32 = 4;
 /// Largest tile array accepted (tiles): 1024 × 1024 tiles, i.e. 1.6 km × 1.6 km at 5 cm.
@@ -30,38 +30,95 @@ const MAX_TILE_SLOTS: usize = 1 << 20;
 /// Cell coordinates are clamped to ±this, far beyond any real map, so index arithmetic cannot overflow.
 const COORD_LIMIT: f64 = (1u32 << 28) as f64;
 
-/// One 32×32 patch of cells.
+/// What one cell with hits holds.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct CellHits {
+    /// Mean end point, relative to the cell's lower corner, metres.
+    pub mean: [f32; 2],
+    /// End points that fell in the cell (saturating).
+    pub hits: u16,
+    /// Sum of the unit directions of the beams that ended in the cell, ×[`DIR_SCALE`] (saturating): which side
+    /// the surface was seen from. Zero when unknown (hits recorded without a direction).
+    pub dir: [i16; 2],
+}
+
+/// One 32×32 patch of cells: bitmaps of the seen and the hit cells, and the statistics of the hit cells only.
+///
+/// Most cells of a building's map have no hits (free space and unknown space), so a tile stores the hit cells'
+/// statistics in a list, in row-major order, found by counting the bits before them in `occupied`: a tile that
+/// is only crossed by beams costs 0.3 KB instead of the 14.6 KB of dense per-cell arrays.
 #[derive(Clone)]
 pub struct Tile {
-    /// End points that fell in each cell (saturating), row-major (`ly * 32 + lx`).
-    pub hits: [u16; TILE_CELLS],
-    /// Mean end point of each cell, relative to the cell's lower corner, metres.
-    pub mean: [[f32; 2]; TILE_CELLS],
     /// Per row (`ly`), bit `lx`: whether a beam's end band (see [`TileMap::mark_seen`]) crossed the cell
     /// (known space).
     pub seen: [u32; TILE as usize],
     /// Per row (`ly`), bit `lx`: whether the cell has hits (lets a scan skip empty cells by the word).
     pub occupied: [u32; TILE as usize],
-    /// Sum of the unit directions of the beams that ended in each cell, ×[`DIR_SCALE`] (saturating): which
-    /// side the surface was seen from. Zero when unknown (hits recorded without a direction).
-    pub dir: [[i16; 2]; TILE_CELLS],
+    /// Per row: the index in `cells` of the row's first hit cell.
+    row_start: [u16; TILE as usize],
+    /// The hit cells' statistics, row-major.
+    cells: Vec<CellHits>,
 }
 
-/// Scale of [`Tile::dir`]'s sums of unit vectors.
+/// Scale of [`CellHits::dir`]'s sums of unit vectors.
 pub const DIR_SCALE: f64 = 64.0;
 
 impl Tile {
-    /// Heap bytes of one tile.
-    pub const BYTES: usize = std::mem::size_of::<Tile>();
-
     fn empty() -> Arc<Tile> {
         Arc::new(Tile {
-            hits: [0; TILE_CELLS],
-            mean: [[0.0; 2]; TILE_CELLS],
             seen: [0; TILE as usize],
             occupied: [0; TILE as usize],
-            dir: [[0; 2]; TILE_CELLS],
+            row_start: [0; TILE as usize],
+            cells: Vec::new(),
         })
+    }
+
+    /// Heap bytes of this tile (its `Arc` allocation and its list of hit cells).
+    pub fn bytes(&self) -> usize {
+        std::mem::size_of::<Tile>()
+            + 2 * std::mem::size_of::<usize>()
+            + self.cells.capacity() * std::mem::size_of::<CellHits>()
+    }
+
+    /// Where local cell (lx, ly) is or would be in the list of hit cells.
+    #[inline]
+    fn slot(&self, lx: usize, ly: usize) -> usize {
+        self.row_start[ly] as usize + (self.occupied[ly] & ((1u32 << lx) - 1)).count_ones() as usize
+    }
+
+    /// The statistics of local cell `l` (index as [`local`] gives it), if it has hits.
+    #[inline]
+    pub fn cell(&self, l: usize) -> Option<&CellHits> {
+        let (lx, ly) = (l & TILE_MASK as usize, l >> TILE_SHIFT);
+        if self.occupied[ly] >> lx & 1 == 0 {
+            return None;
+        }
+        Some(&self.cells[self.slot(lx, ly)])
+    }
+
+    /// Hits of local cell `l` (0 when none).
+    #[inline]
+    pub fn hits(&self, l: usize) -> u16 {
+        self.cell(l).map_or(0, |c| c.hits)
+    }
+
+    /// Whether local cell `l` has hits.
+    #[inline]
+    pub fn is_hit(&self, l: usize) -> bool {
+        self.occupied[l >> TILE_SHIFT] >> (l & TILE_MASK as usize) & 1 != 0
+    }
+
+    /// The statistics of local cell (lx, ly), added (empty) when it had no hits.
+    fn cell_mut(&mut self, lx: usize, ly: usize) -> &mut CellHits {
+        let at = self.slot(lx, ly);
+        if self.occupied[ly] >> lx & 1 == 0 {
+            self.occupied[ly] |= 1 << lx;
+            self.cells.insert(at, CellHits::default());
+            for start in &mut self.row_start[ly + 1..] {
+                *start += 1;
+            }
+        }
+        &mut self.cells[at]
     }
 }
 
@@ -128,7 +185,7 @@ impl TileMap {
     #[inline]
     pub fn hits(&self, ix: i32, iy: i32) -> u16 {
         match self.tile(ix >> TILE_SHIFT, iy >> TILE_SHIFT) {
-            Some(t) => t.hits[local(ix, iy)],
+            Some(t) => t.hits(local(ix, iy)),
             None => 0,
         }
     }
@@ -136,8 +193,8 @@ impl TileMap {
     /// Mean end point of cell (ix, iy) in the map frame (the cell's corner when it has no hits).
     #[inline]
     pub fn mean(&self, ix: i32, iy: i32) -> (f64, f64) {
-        let m = match self.tile(ix >> TILE_SHIFT, iy >> TILE_SHIFT) {
-            Some(t) => t.mean[local(ix, iy)],
+        let m = match self.tile(ix >> TILE_SHIFT, iy >> TILE_SHIFT).and_then(|t| t.cell(local(ix, iy))) {
+            Some(c) => c.mean,
             None => [0.0, 0.0],
         };
         (ix as f64 * self.delta + m[0] as f64, iy as f64 * self.delta + m[1] as f64)
@@ -191,16 +248,15 @@ impl TileMap {
         self.ensure(tx, ty)?;
         let slot = ((ty - self.ty0) * self.tw + (tx - self.tx0)) as usize;
         let tile = Arc::make_mut(self.tiles[slot].get_or_insert_with(Tile::empty));
-        let i = local(ix, iy);
-        let n = tile.hits[i].saturating_add(1);
-        tile.hits[i] = n;
-        tile.occupied[(iy & TILE_MASK) as usize] |= 1 << (ix & TILE_MASK);
+        let cell = tile.cell_mut((ix & TILE_MASK) as usize, (iy & TILE_MASK) as usize);
+        let n = cell.hits.saturating_add(1);
+        cell.hits = n;
         let (ox, oy) = (x - ix as f64 * self.delta, y - iy as f64 * self.delta);
-        let m = &mut tile.mean[i];
+        let m = &mut cell.mean;
         let inv = 1.0 / n as f64;
         m[0] += ((ox - m[0] as f64) * inv) as f32;
         m[1] += ((oy - m[1] as f64) * inv) as f32;
-        let d = &mut tile.dir[i];
+        let d = &mut cell.dir;
         d[0] = d[0].saturating_add((dx * DIR_SCALE).round() as i16);
         d[1] = d[1].saturating_add((dy * DIR_SCALE).round() as i16);
         Ok(())
@@ -313,6 +369,11 @@ impl TileMap {
     pub fn tile_ptrs(&self) -> impl Iterator<Item = *const Tile> + '_ {
         self.tiles.iter().flatten().map(Arc::as_ptr)
     }
+
+    /// The allocated tiles (shared or not).
+    pub fn tiles(&self) -> impl Iterator<Item = &Tile> + '_ {
+        self.tiles.iter().flatten().map(|t| &**t)
+    }
 }
 
 /// Index of cell (ix, iy) inside its tile.
@@ -376,6 +437,46 @@ mod tests {
         assert_eq!(shared(&a, &b), 1, "the written tile was copied");
         assert_eq!(a.hits(4, 4), 0);
         assert_eq!(b.hits(4, 4), 1);
+    }
+
+    #[test]
+    fn hit_cells_added_in_any_order_keep_their_own_statistics() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
+        let mut m = TileMap::new(0.05);
+        let mut truth = std::collections::BTreeMap::new();
+        for _ in 0..5000 {
+            let (ix, iy) = (rng.random_range(-40..40), rng.random_range(-40..40));
+            let (fx, fy) = (rng.random_range(0.0..0.05), rng.random_range(0.0..0.05));
+            m.add_hit(ix as f64 * 0.05 + fx, iy as f64 * 0.05 + fy).unwrap();
+            let e = truth.entry((ix, iy)).or_insert((0u16, 0.0, 0.0));
+            e.0 += 1;
+            e.1 += (ix as f64 * 0.05 + fx - e.1) / e.0 as f64;
+            e.2 += (iy as f64 * 0.05 + fy - e.2) / e.0 as f64;
+        }
+        for ix in -45..45 {
+            for iy in -45..45 {
+                let (n, mx, my) = truth.get(&(ix, iy)).copied().unwrap_or((0, 0.0, 0.0));
+                assert_eq!(m.hits(ix, iy), n, "cell ({ix}, {iy})");
+                if n > 0 {
+                    let (ax, ay) = m.mean(ix, iy);
+                    assert!((ax - mx).abs() < 1e-5 && (ay - my).abs() < 1e-5, "({ix}, {iy}): {ax} {ay} vs {mx} {my}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_tile_stores_only_its_hit_cells() {
+        let mut m = TileMap::new(0.05);
+        m.mark_seen(0.0, 0.01, 1.5, 0.01).unwrap();
+        let seen_only = m.tiles().next().unwrap().bytes();
+        assert!(seen_only < 512, "a tile crossed by a beam holds no cell statistics: {seen_only} bytes");
+        for i in 0..32 {
+            m.add_hit(i as f64 * 0.05 + 0.01, 0.8).unwrap();
+        }
+        let wall = m.tiles().next().unwrap().bytes();
+        assert!(wall < seen_only + 32 * 2 * std::mem::size_of::<CellHits>(), "a wall of 32 cells: {wall} bytes");
     }
 
     #[test]

@@ -110,6 +110,16 @@ impl LoopGraph {
         &self.nodes
     }
 
+    /// Heap bytes held: the nodes with their scans, the edges and the cached submap grids.
+    pub fn bytes(&self) -> usize {
+        let scans: usize =
+            self.nodes.iter().map(|n| 4 * n.scan.ranges.capacity() + std::mem::size_of::<LaserScan>()).sum();
+        let per_node =
+            std::mem::size_of::<TrajectoryNode>() + 3 * std::mem::size_of::<Xyt>() + 2 * std::mem::size_of::<f64>();
+        let edges = (self.chain.len() + self.loops.len()) * std::mem::size_of::<Edge>();
+        scans + self.nodes.len() * per_node + edges + self.cache.bytes()
+    }
+
     /// What the graph did so far.
     pub fn report(&self) -> LoopClosureReport {
         self.report

@@ -62,6 +62,14 @@ impl SubmapGrids {
     }
 }
 
+impl SubmapGrids {
+    /// Heap bytes of the grids.
+    pub fn bytes(&self) -> usize {
+        let tiles: usize = self.tiles.tiles().map(|t| t.bytes()).sum();
+        tiles + self.pyramid.levels.iter().map(|l| l.bytes()).sum::<usize>()
+    }
+}
+
 /// The last few submaps' grids, by submap index and the graph's version when they were built (an optimisation
 /// moves the nodes within a submap, so a grid built before it is rebuilt).
 #[derive(Debug, Clone, Default)]
@@ -80,6 +88,11 @@ impl GridCache {
         let grids = e.2.clone();
         self.entries.push(e);
         Some(grids)
+    }
+
+    /// Heap bytes of the cached grids.
+    pub fn bytes(&self) -> usize {
+        self.entries.iter().map(|e| e.2.bytes()).sum()
     }
 
     /// Keeps `grids`, dropping the least recently used beyond the cache's size.

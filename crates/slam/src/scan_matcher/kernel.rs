@@ -43,8 +43,8 @@ impl ScanMatcher {
             for yy in -k..=k {
                 for xx in -k..=k {
                     let i = (base + yy * TILE + xx) as usize;
-                    if tile.hits[i] > 0 && tile.hits[(i as i32 + foff) as usize] == 0 {
-                        let m = tile.mean[i];
+                    if tile.is_hit(i) && !tile.is_hit((i as i32 + foff) as usize) {
+                        let Some(m) = tile.cell(i).map(|c| c.mean) else { continue };
                         let ex = rx - xx as f64 * delta - m[0] as f64;
                         let ey = ry - yy as f64 * delta - m[1] as f64;
                         best = best.min(ex * ex + ey * ey);
