@@ -1,8 +1,8 @@
 //! Controllers: pure pursuit along waypoints, frontier exploration on the robot's own map, or none.
 
-use mrslam_core::{CellState, LaserScan, OccupancyGrid, Pose2, Xyt};
+use crate::frontier::frontier_path;
+use mrslam_core::{LaserScan, OccupancyGrid, Pose2, Xyt};
 use nalgebra::Point2;
-use std::collections::VecDeque;
 
 /// What drives a robot during a run.
 #[derive(Debug, Clone)]
@@ -147,7 +147,8 @@ impl PurePursuit {
 ///
 /// Works entirely in the SLAM map frame with the SLAM pose, as an autonomous robot must. Frontier cells are
 /// free cells next to unknown ones; reachability is a breadth-first search over free cells at least
-/// `clearance` from any occupied cell.
+/// `clearance` from any occupied cell (see [`crate::frontier`]). A team planner may instead hand it the path
+/// to follow ([`Self::follow`]) or tell it that nothing is left ([`Self::finish`]).
 #[derive(Debug, Clone)]
 pub struct Explorer {
     /// Distance kept from walls when planning, metres.
@@ -213,18 +214,32 @@ impl Explorer {
 
     /// Plans a path to the nearest frontier on `map` from `pose` (both in the SLAM frame).
     pub fn plan(&mut self, map: &OccupancyGrid, pose: &Pose2) {
-        self.since_plan = 0.0;
         match frontier_path(map, pose, self.clearance, &self.abandoned, Self::ABANDONED_RADIUS) {
-            Some(path) => {
-                let mut f = PurePursuit::new(path, self.speed);
-                f.lookahead = Self::LOOKAHEAD;
-                self.follower = Some(f);
-            }
-            None => {
-                self.follower = None;
-                self.finished = true;
-            }
+            Some(path) => self.follow(path),
+            None => self.finish(),
         }
+    }
+
+    /// Follows `path` (the frame of the pose later given to [`Self::command`]) from now on, replacing the goal
+    /// it had; the replan period starts again.
+    pub fn follow(&mut self, path: Vec<Point2<f64>>) {
+        self.since_plan = 0.0;
+        self.finished = false;
+        let mut f = PurePursuit::new(path, self.speed);
+        f.lookahead = Self::LOOKAHEAD;
+        self.follower = Some(f);
+    }
+
+    /// Stops exploring: nothing reachable is left to explore.
+    pub fn finish(&mut self) {
+        self.since_plan = 0.0;
+        self.follower = None;
+        self.finished = true;
+    }
+
+    /// The goal it drives to (the last point of its path), if it has one.
+    pub fn goal(&self) -> Option<Point2<f64>> {
+        self.follower.as_ref().and_then(PurePursuit::goal)
     }
 
     /// Forward speed and turn rate for the robot at `pose` (SLAM frame); `blocked` when something is in the
@@ -255,92 +270,6 @@ impl Explorer {
     }
 }
 
-/// Path (SLAM frame) to the nearest reachable frontier cell, thinned to one point every ~0.4 m.
-///
-/// A frontier cell is a free cell with at least [`FRONTIER_MIN_UNKNOWN`] unknown cells among its eight
-/// neighbours (the edge of unexplored space, not a one-cell hole between two far beams), outside the robot's
-/// own disc and farther than `avoid_radius` from every point of `avoid`. The disc of radius `clearance` around
-/// the robot is passable wherever it is not occupied: the robot stands there, and a lidar does not see the
-/// cells under and behind the robot.
-pub fn frontier_path(
-    map: &OccupancyGrid,
-    pose: &Pose2,
-    clearance: f64,
-    avoid: &[Point2<f64>],
-    avoid_radius: f64,
-) -> Option<Vec<Point2<f64>>> {
-    let (w, h) = (map.width(), map.height());
-    let r = (clearance / map.resolution()).ceil() as i64;
-    // Cells too close to a wall are blocked.
-    let mut blocked = vec![false; w * h];
-    for iy in 0..h {
-        for ix in 0..w {
-            if map.state(ix, iy) == CellState::Occupied {
-                for dy in -r..=r {
-                    for dx in -r..=r {
-                        let (x, y) = (ix as i64 + dx, iy as i64 + dy);
-                        if dx * dx + dy * dy <= r * r && map.contains_cell(x, y) {
-                            blocked[y as usize * w + x as usize] = true;
-                        }
-                    }
-                }
-            }
-        }
-    }
-    let start = map.world_to_cell(&Point2::new(pose.translation.x, pose.translation.y))?;
-    let (sx, sy) = (start.0 as i64, start.1 as i64);
-    let on_robot = |x: i64, y: i64| (x - sx).pow(2) + (y - sy).pow(2) <= r * r;
-    let state = |x: i64, y: i64| map.get_checked(x, y).map(CellState::from_log_odds);
-    let s = start.1 * w + start.0;
-    let mut parent = vec![usize::MAX; w * h];
-    parent[s] = s;
-    let mut queue = VecDeque::from([s]);
-    while let Some(c) = queue.pop_front() {
-        let (cx, cy) = ((c % w) as i64, (c / w) as i64);
-        let unknown_around = (-1..=1)
-            .flat_map(|dy| (-1..=1).map(move |dx| (dx, dy)))
-            .filter(|&(dx, dy)| state(cx + dx, cy + dy) == Some(CellState::Unknown))
-            .count();
-        let avoided = || {
-            let p = map.cell_center(cx, cy);
-            avoid.iter().any(|q| (p - q).norm() <= avoid_radius)
-        };
-        if state(cx, cy) == Some(CellState::Free)
-            && unknown_around >= FRONTIER_MIN_UNKNOWN
-            && !on_robot(cx, cy)
-            && !avoided()
-        {
-            let mut cells = vec![c];
-            let mut k = c;
-            while parent[k] != k {
-                k = parent[k];
-                cells.push(k);
-            }
-            cells.reverse();
-            let step = ((0.4 / map.resolution()) as usize).max(1);
-            let mut path: Vec<Point2<f64>> =
-                cells.iter().step_by(step).map(|&k| map.cell_center((k % w) as i64, (k / w) as i64)).collect();
-            path.push(map.cell_center(cx, cy));
-            return Some(path);
-        }
-        for (dx, dy) in [(1i64, 0i64), (-1, 0), (0, 1), (0, -1)] {
-            let (nx, ny) = (cx + dx, cy + dy);
-            let Some(st) = state(nx, ny) else { continue };
-            let n = ny as usize * w + nx as usize;
-            let passable =
-                if on_robot(nx, ny) { st != CellState::Occupied } else { st == CellState::Free && !blocked[n] };
-            if parent[n] == usize::MAX && passable {
-                parent[n] = c;
-                queue.push_back(n);
-            }
-        }
-    }
-    None
-}
-
-/// Unknown cells among a frontier cell's eight neighbours, at least.
-pub const FRONTIER_MIN_UNKNOWN: usize = 3;
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -363,53 +292,6 @@ mod tests {
         assert!(pp.is_done(), "did not arrive in 60 s");
         let Xyt { x, y, .. } = Xyt::from_pose(&p);
         assert!(x.hypot(y - 2.0) < 0.1);
-    }
-
-    #[test]
-    fn frontier_is_found_through_the_door() {
-        // A 4 m x 2 m known room, walled, with a gap in the east wall; unknown beyond.
-        let mut g = OccupancyGrid::new(120, 40, 0.05, pose(0.0, 0.0, 0.0)).unwrap();
-        for iy in 0..40 {
-            for ix in 0..80 {
-                let wall = ix == 0 || iy == 0 || iy == 39 || (ix == 79 && !(15..25).contains(&iy));
-                g.set(ix, iy, if wall { 2.0 } else { -2.0 });
-            }
-        }
-        let path = frontier_path(&g, &pose(1.0, 1.0, 0.0), 0.15, &[], 0.0).expect("a frontier");
-        let end = path.last().unwrap();
-        assert!(end.x > 3.9 && end.y > 0.7 && end.y < 1.3, "{end:?}");
-        for iy in 15..25 {
-            g.set(79, iy, 2.0);
-        }
-        assert!(frontier_path(&g, &pose(1.0, 1.0, 0.0), 0.15, &[], 0.0).is_none(), "closed door: nothing to explore");
-    }
-
-    #[test]
-    fn a_robot_that_cannot_see_behind_itself_still_finds_its_frontier() {
-        // A walled 4 m x 2 m room seen by a forward-looking lidar mounted ahead of the axle at (1.05, 1): the
-        // robot's own cell and everything behind it are unknown, and so is a one-cell hole far ahead.
-        let mut g = OccupancyGrid::new(80, 40, 0.05, pose(0.0, 0.0, 0.0)).unwrap();
-        for iy in 0..40 {
-            for ix in 0..80 {
-                let wall = ix == 0 || iy == 0 || iy == 39 || ix == 79;
-                let seen = ix > 22;
-                if wall {
-                    g.set(ix, iy, 2.0);
-                } else if seen && (ix, iy) != (60, 20) {
-                    g.set(ix, iy, -2.0);
-                }
-            }
-        }
-        let path = frontier_path(&g, &pose(1.05, 1.0, 0.0), 0.3, &[], 0.0).expect("the unseen space behind the robot");
-        let end = path.last().unwrap();
-        assert!(end.x < 1.3, "it drives to the edge of the unseen space, not to the hole: {end:?}");
-        // Once the space behind is seen, only the hole is left, and a hole is no frontier.
-        for iy in 1..39 {
-            for ix in 1..23 {
-                g.set(ix, iy, -2.0);
-            }
-        }
-        assert!(frontier_path(&g, &pose(1.05, 1.0, 0.0), 0.3, &[], 0.0).is_none());
     }
 
     fn scan_with_one_hit(bearing: f64, range: f32) -> LaserScan {

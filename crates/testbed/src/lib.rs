@@ -16,6 +16,7 @@
 
 pub mod controller;
 pub mod eval;
+pub mod frontier;
 pub mod report;
 pub mod runner;
 pub mod scenario;
