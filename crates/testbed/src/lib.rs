@@ -14,6 +14,7 @@
 // Every module is a public namespace (`scenario::Scenario`, `runner::run`...); nothing is
 // re-exported at the root, so each item has one path.
 
+pub mod assignment;
 pub mod controller;
 pub mod eval;
 pub mod frontier;
