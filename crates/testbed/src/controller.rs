@@ -352,4 +352,25 @@ mod tests {
         let second = e.follower.as_ref().and_then(PurePursuit::goal).unwrap();
         assert!(second.x < 0.5, "then the west one: {second:?}");
     }
+
+    #[test]
+    fn an_explorer_follows_the_path_a_team_planner_gives_and_stops_when_told() {
+        let mut e = Explorer::new(0.3, 0.2);
+        assert!(e.wants_plan() && e.goal().is_none());
+        e.follow(vec![Point2::new(0.0, 0.0), Point2::new(1.0, 0.0)]);
+        assert_eq!(e.goal(), Some(Point2::new(1.0, 0.0)));
+        assert!(!e.wants_plan(), "a fresh path: no replan before the period");
+        let (v, _) = e.command(&pose(0.0, 0.0, 0.0), 0.1, false);
+        assert!(v > 0.0, "it drives along the path");
+        for _ in 0..30 {
+            e.command(&pose(0.0, 0.0, 0.0), 0.1, false);
+        }
+        assert!(e.wants_plan(), "the replan period is over");
+        e.follow(vec![Point2::new(0.0, 0.0), Point2::new(0.0, 2.0)]);
+        assert_eq!(e.goal(), Some(Point2::new(0.0, 2.0)), "the new path replaces the old");
+        assert!(!e.wants_plan());
+        e.finish();
+        assert!(e.is_done() && !e.wants_plan() && e.goal().is_none());
+        assert_eq!(e.command(&pose(0.0, 0.0, 0.0), 0.1, false), (0.0, 0.0));
+    }
 }
