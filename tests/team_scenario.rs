@@ -70,7 +70,7 @@ fn three_robots_drive_map_and_are_each_evaluated() {
         assert!(out.frames.contains_key(name) && !out.paths[name].is_empty(), "{name}: frame and path");
     }
     // The merge pair: the host and the first other robot in the file's order.
-    assert_eq!(r.merge_pair, ["prawn".to_string(), "experia".to_string()]);
+    assert_eq!(r.merge_pair, Some(["prawn".to_string(), "experia".to_string()]));
     assert_eq!(r.merges.len(), 1);
     let m = &r.merges[0];
     assert!(!m.accepted || m.success, "an accepted merge is right: {m:?}");

@@ -79,7 +79,8 @@ impl RunBag {
             w.map(&format!("/{name}/map"), &robot_frame(name, "map"), t, map).with_context(context)?;
         }
         w.map("/truth_map", WORLD_FRAME, t, &out.truth).with_context(context)?;
-        let host_frame = robot_frame(&out.report.merge_pair[0], "map");
+        let host = out.report.merge_pair.as_ref().map_or("", |[host, _]| host.as_str());
+        let host_frame = robot_frame(host, "map");
         for m in &out.merges {
             if let Some(g) = &m.merged {
                 let topic = match out.merges.len() {

@@ -60,7 +60,7 @@ pub use cascade::{Cascade, Stage};
 pub use config::MergerConfig;
 pub use correlative::{AnswerParams, CorrelativeMerger, CorrelativeParams, FallbackParams, FineParams, SearchParams};
 pub use estimate::{Model, RansacParams};
-pub use fuse::FusionRule;
+pub use fuse::{FusionRule, fuse as fuse_maps};
 pub use map_image::{Encoding, MapEncoding, MapImage};
 pub use matching::MatchParams;
 pub use merge_params::MergeParams;

@@ -18,6 +18,7 @@
 //! start_experia = { x = 1, y = 1, theta = 0 }
 //! [bitmap]                       # optional: a ROS map_server map; occupied cells become obstacles
 //! map = "floor.yaml"             # relative to the world file
+//! unknown = "free"               # the map's unknown cells: "free" (default) or "occupied" (a closed building)
 //! ```
 
 use crate::error::SimError;
@@ -101,6 +102,7 @@ impl NamedPoint {
 #[serde(deny_unknown_fields)]
 struct BitmapSpec {
     map: String,
+    unknown: Option<String>,
 }
 
 /// A loaded bitmap layer: a ROS map whose occupied cells are obstacles.
@@ -272,9 +274,28 @@ impl WorldSpec {
                     message: "must name a map_server YAML file".into(),
                 });
             }
+            let closed = match b.unknown.as_deref() {
+                None | Some("free") => false,
+                Some("occupied") => true,
+                Some(other) => {
+                    return Err(SimError::WorldFile {
+                        path: path.to_path_buf(),
+                        line,
+                        field: "bitmap.unknown".into(),
+                        message: format!("expected \"free\" or \"occupied\", got \"{other}\""),
+                    });
+                }
+            };
             let map = mrslam_core::map_io::resolve_image_path(path, &b.map);
-            let grid = mrslam_core::map_io::read_ros_map(&map)
+            let mut grid = mrslam_core::map_io::read_ros_map(&map)
                 .map_err(|cause| SimError::Bitmap { path: path.to_path_buf(), cause })?;
+            if closed {
+                // Unknown cells (log-odds 0) become walls: what the map's robot never saw is not driven into.
+                grid.cells_mut()
+                    .iter_mut()
+                    .filter(|l| **l == 0.0)
+                    .for_each(|l| *l = mrslam_core::map_io::ROS_LOGODDS_LIMIT);
+            }
             spec.bitmap = Some(BitmapLayer { map, grid });
         }
         Ok(spec)

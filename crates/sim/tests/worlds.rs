@@ -185,3 +185,32 @@ fn bitmap_layer_becomes_merged_obstacles() {
     }
     assert!(sim.true_pose(id).unwrap().translation.x < 1.0 - 0.15 + 0.01);
 }
+
+#[test]
+fn a_bitmaps_unknown_cells_may_be_walls_so_the_building_is_closed() {
+    let dir = tempfile::tempdir().unwrap();
+    // A 30 x 20 cell map at 0.1 m: a free room of 10 x 10 cells in the middle, unknown around it, no wall.
+    let (w, h) = (30usize, 20usize);
+    let cells: Vec<f32> = (0..w * h)
+        .map(|i| if (10..20).contains(&(i % w)) && (5..15).contains(&(i / w)) { -2.0 } else { 0.0 })
+        .collect();
+    let grid = mrslam_core::OccupancyGrid::from_cells(w, h, 0.1, pose(0.0, 0.0, 0.0), cells).unwrap();
+    mrslam_core::map_io::write_ros_map(&grid, &dir.path().join("floor.yaml")).unwrap();
+    let world_at = |unknown: &str| {
+        let file = dir.path().join("w.toml");
+        std::fs::write(&file, format!("name = \"room\"\n[bitmap]\nmap = \"floor.yaml\"\n{unknown}\n")).unwrap();
+        WorldSpec::from_toml_file(&file).map(|spec| World::from_spec(&spec).unwrap())
+    };
+    let open = world_at("").unwrap();
+    let closed = world_at("unknown = \"occupied\"").unwrap();
+    let (inside, outside) = (nalgebra::Point2::new(1.5, 1.0), nalgebra::Point2::new(0.5, 1.0));
+    assert!(!open.is_occupied(&outside) && !open.is_occupied(&inside));
+    assert!(closed.is_occupied(&outside) && !closed.is_occupied(&inside));
+    // A beam east from the room's middle stops at the room's edge (x = 2.0 m) in the closed world only.
+    let r = closed.cast_ray(&inside, 0.0, 10.0).unwrap();
+    assert!((r - 0.5).abs() < 1e-9, "{r}");
+    assert!(open.cast_ray(&inside, 0.0, 10.0).is_none());
+    // Anything else names the field and the line.
+    let e = world_at("unknown = \"walls\"").unwrap_err().to_string();
+    assert!(e.contains("w.toml:2: bitmap.unknown: expected \"free\" or \"occupied\""), "{e}");
+}

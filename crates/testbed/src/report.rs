@@ -98,13 +98,18 @@ pub struct RunReport {
     pub merge_at_s: f64,
     /// The robots whose maps were merged: the host (the merge's frame), and the robot whose map was merged into
     /// it. With more than two robots, the others' maps are evaluated but not merged.
-    pub merge_pair: [String; 2],
+    ///
+    /// `None` for a team of one robot.
+    pub merge_pair: Option<[String; 2]>,
     /// Per-robot results, by name.
     pub robots: BTreeMap<String, RobotReport>,
     /// One entry per algorithm.
     pub merges: Vec<MergeResult>,
     /// Jaccard overlap of the true cells the two robots of the merge pair observed.
     pub observed_overlap: f64,
+    /// A scenario with a `[team]` table: the merges while driving, coverage and communication.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub team: Option<TeamReport>,
 }
 
 impl RunReport {
@@ -134,9 +139,13 @@ impl RunReport {
                 if r.finished { "" } else { ", route NOT finished" }
             );
         }
-        if self.robots.len() > 2 {
-            let [host, other] = &self.merge_pair;
-            s += &format!("  merges of {host}'s and {other}'s maps (the other robots' maps are not merged)\n");
+        if let Some(team) = &self.team {
+            s += &team.summary();
+        }
+        if let (true, Some([host, other])) = (self.robots.len() > 2, &self.merge_pair) {
+            s += &format!(
+                "  merges of {host}'s and {other}'s maps after driving (the other robots' maps are not merged)\n"
+            );
         }
         for m in &self.merges {
             let at_end = match (m.rotation_error_at_end_deg, m.translation_error_at_end_m) {
@@ -158,6 +167,123 @@ impl RunReport {
                 m.reason.as_ref().map_or(String::new(), |r| format!(": {r}"))
             );
         }
+        s
+    }
+}
+
+/// One try at joining two teams' maps while the robots drive.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct MergeAttempt {
+    /// Simulated time, seconds.
+    pub time_s: f64,
+    /// The two robots in contact (host team's first).
+    pub robots: [String; 2],
+    /// The robots of the host's team and of the other's before the try.
+    pub teams: [Vec<String>; 2],
+    /// Passed the merger's gate: the teams joined.
+    pub accepted: bool,
+    /// Accepted and within the scenario's success thresholds of the true transform; `false` when accepted
+    /// outside them (a false merge: the teams joined on a wrong transform) or refused.
+    pub correct: bool,
+    /// Rotation error of the merger's transform against the truth, degrees (null without a transform).
+    pub rotation_error_deg: Option<f64>,
+    /// Translation error, metres.
+    pub translation_error_m: Option<f64>,
+    /// The cascade's deciding stage.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stage: Option<String>,
+    /// Why the gate refused.
+    pub reason: Option<String>,
+    /// Merge wall time, milliseconds.
+    pub time_ms: f64,
+}
+
+/// A joined team's frontier assignment at one moment.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct TeamPlan {
+    /// Simulated time, seconds.
+    pub time_s: f64,
+    /// The team's root robot: the targets are in its SLAM frame.
+    pub root: String,
+    /// Each exploring robot of the team and its target (x, y in the root's frame; null: none reachable).
+    pub targets: BTreeMap<String, Option<[f64; 2]>>,
+}
+
+/// A team run's results: coverage of the true free area over time, the online merges, communication.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct TeamReport {
+    /// Coordination of joined teams (`none` or `frontiers`).
+    pub coordination: String,
+    /// Communication range, metres.
+    pub range_m: f64,
+    /// The merger of the online merges.
+    pub merger: String,
+    /// Free area of the truth the robots can reach, m².
+    pub reachable_free_m2: f64,
+    /// (simulated time s, share of the reachable free area some robot's map marks free), oldest first.
+    pub coverage: Vec<[f64; 2]>,
+    /// The last sample's share.
+    pub final_coverage: f64,
+    /// First time the coverage reached 50 %, seconds (null: never).
+    pub time_to_50_s: Option<f64>,
+    /// First time it reached 90 %.
+    pub time_to_90_s: Option<f64>,
+    /// First time it reached 95 %.
+    pub time_to_95_s: Option<f64>,
+    /// Distance driven by all robots, metres (each robot's is in `robots`).
+    pub distance_m: f64,
+    /// Of the reachable free area the robots' beams crossed, the share more than one robot's crossed.
+    pub redundancy: f64,
+    /// Time of the first accepted and correct merge, seconds.
+    pub first_correct_merge_s: Option<f64>,
+    /// Online merges accepted.
+    pub merges_accepted: usize,
+    /// Online merges refused by the gate.
+    pub merges_refused: usize,
+    /// Online merges accepted on a wrong transform (also counted in `merges_accepted`).
+    pub merges_false: usize,
+    /// Bytes of map messages sent (each a ROS `nav_msgs/OccupancyGrid`: one byte a cell and its header).
+    pub bytes_exchanged: u64,
+    /// Every merge attempt, in time order.
+    pub attempts: Vec<MergeAttempt>,
+    /// Every joint plan of a joined team (coordination `frontiers`), in time order.
+    pub plans: Vec<TeamPlan>,
+    /// The teams at the end: each a list of robot names, its root (the frame of its map) first.
+    pub teams: Vec<Vec<String>>,
+    /// Carpin's acceptance index of the largest team's merged map against the truth.
+    pub team_map_acceptance: Option<f64>,
+}
+
+impl TeamReport {
+    /// The lines the run's summary prints for the team.
+    pub fn summary(&self) -> String {
+        let t = |v: Option<f64>| v.map_or("never".to_string(), |s| format!("{s:.0} s"));
+        let teams: Vec<String> = self.teams.iter().map(|m| format!("[{}]", m.join(", "))).collect();
+        let mut s = format!(
+            "  team ({} coordination, range {:.1} m, {}): coverage {:.1} % of {:.0} m² reachable (50 % at {}, 90 % at {}, \
+             95 % at {}), {:.0} m driven, redundancy {:.2}\n",
+            self.coordination,
+            self.range_m,
+            self.merger,
+            100.0 * self.final_coverage,
+            self.reachable_free_m2,
+            t(self.time_to_50_s),
+            t(self.time_to_90_s),
+            t(self.time_to_95_s),
+            self.distance_m,
+            self.redundancy
+        );
+        s += &format!(
+            "  online merges: {} accepted ({} FALSE), {} refused, first correct at {}; {:.1} MB of maps exchanged; \
+             teams {}{}\n",
+            self.merges_accepted,
+            self.merges_false,
+            self.merges_refused,
+            t(self.first_correct_merge_s),
+            self.bytes_exchanged as f64 / 1e6,
+            teams.join(" "),
+            self.team_map_acceptance.map_or(String::new(), |a| format!(", team map acceptance {a:.3}"))
+        );
         s
     }
 }

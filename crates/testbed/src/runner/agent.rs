@@ -33,6 +33,8 @@ pub(super) struct Agent<'s> {
     pub slam_s: f64,
     /// Truth-map cells this robot's beams crossed or hit.
     pub observed: Vec<bool>,
+    /// The robot explores as one of a team whose planner gives it its paths (it does not plan on its own map).
+    pub coordinated: bool,
 }
 
 impl Agent<'_> {
@@ -59,7 +61,7 @@ impl Agent<'_> {
             Controller::Waypoints(p) => Ok(p.command(true_pose, dt)),
             Controller::Explore(e) => {
                 let slam_pose = self.slam.best_pose();
-                if e.wants_plan() && !self.processed.is_empty() {
+                if e.wants_plan() && !self.processed.is_empty() && !self.coordinated {
                     let map =
                         self.slam.map().map_err(|error| RunError::Slam { robot: self.setup.name.clone(), error })?;
                     e.plan(&map, &slam_pose);
@@ -154,6 +156,7 @@ pub(super) fn add_robots<'s>(
             contact_steps: 0,
             slam_s: 0.0,
             observed: vec![false; truth.width() * truth.height()],
+            coordinated: false,
         });
     }
     Ok(agents)

@@ -2,8 +2,10 @@
 //! that came in are fed to the robots' SLAM back-ends, all robots side by side.
 
 use super::agent::{Agent, Reading};
+use super::coordinate::Planner;
 use super::options::{RobotStep, RunError, RunOptions};
 use super::record::{viz_slam, viz_step};
+use super::team::Teams;
 use crate::controller::Controller;
 use crate::scenario::{MergeWhen, Scenario};
 use mrslam_core::{LaserScan, OccupancyGrid};
@@ -19,11 +21,14 @@ pub(super) fn drive(
     sim: &mut Sim,
     agents: &mut [Agent],
     truth: &OccupancyGrid,
+    mut teams: Option<&mut Teams>,
     opts: &mut RunOptions,
 ) -> Result<u64, RunError> {
     let dt = scenario.dt;
     let mut steps = 0u64;
     let mut next_progress = 0.0;
+    let mut planner =
+        teams.as_ref().map(|_| Planner::new(agents.len(), scenario.team.as_ref().map_or(1.0, |t| t.beta)));
     loop {
         let t = sim.time();
         if let Some(p) = opts.progress.as_mut()
@@ -39,6 +44,9 @@ pub(super) fn drive(
         };
         if merge_now || t >= scenario.duration - 1e-9 {
             return Ok(steps);
+        }
+        if let (Some(tm), Some(p)) = (teams.as_deref_mut(), planner.as_mut()) {
+            p.plan(t, tm, agents)?;
         }
         for a in agents.iter_mut() {
             let true_pose = sim.true_pose(a.id)?;
@@ -86,6 +94,12 @@ pub(super) fn drive(
         results.into_iter().collect::<Result<(), RunError>>()?;
         if let Some(v) = opts.viz.as_deref_mut() {
             viz_slam(v, agents)?;
+        }
+        if let Some(tm) = teams.as_deref_mut() {
+            let joined = tm.after_step(sim.time(), agents, truth)?;
+            if let Some(p) = planner.as_mut() {
+                p.replan(&joined);
+            }
         }
     }
 }

@@ -15,11 +15,15 @@ use mrslam_core::{OccupancyGrid, Xyt};
 use mrslam_merge::{Algorithm, MergeOutcome, MergeParams, Merger, merge};
 
 /// The host robot's name and the other's: a run takes two or more robots of distinct names, one of them the
-/// host; the other is the first robot in the scenario's order that is not the host.
+/// host; the other is the first robot in the scenario's order that is not the host. A team of one robot has no
+/// pair (`None`).
 ///
 /// [`Scenario::from_file`] checks this; a scenario built or changed in code may not hold to it.
-pub(super) fn merge_pair(scenario: &Scenario) -> Result<(String, String), RunError> {
+pub(super) fn merge_pair(scenario: &Scenario) -> Result<Option<(String, String)>, RunError> {
     let robots = &scenario.robots;
+    if robots.len() == 1 && scenario.team.is_some() {
+        return Ok(None);
+    }
     if robots.len() < 2 {
         return Err(RunError::Scenario(format!(
             "a run takes at least two robots (a merge needs two maps), found {}",
@@ -36,7 +40,7 @@ pub(super) fn merge_pair(scenario: &Scenario) -> Result<(String, String), RunErr
         return Err(RunError::Scenario(format!("the merge host `{host}` is not one of the robots")));
     }
     let other = robots.iter().find(|r| r.name != *host).map(|r| r.name.clone()).unwrap_or_default();
-    Ok((host.clone(), other))
+    Ok(Some((host.clone(), other)))
 }
 
 /// Share of the truth cells seen by either robot of the pair that both saw.
@@ -106,15 +110,15 @@ mod tests {
     fn the_host_comes_first_in_the_merge_pair() {
         let mut s = two_rooms();
         let (a, b) = (s.robots[0].name.clone(), s.robots[1].name.clone());
-        assert_eq!(merge_pair(&s).unwrap(), (a.clone(), b.clone()));
+        assert_eq!(merge_pair(&s).unwrap().unwrap(), (a.clone(), b.clone()));
         s.merge.host = b.clone();
-        assert_eq!(merge_pair(&s).unwrap(), (b.clone(), a.clone()));
+        assert_eq!(merge_pair(&s).unwrap().unwrap(), (b.clone(), a.clone()));
         // A third robot: the host is merged with the first other robot.
         let mut third = s.robots[0].clone();
         third.name = "third".into();
         s.robots.push(third);
-        assert_eq!(merge_pair(&s).unwrap(), (b.clone(), a.clone()));
+        assert_eq!(merge_pair(&s).unwrap().unwrap(), (b.clone(), a.clone()));
         s.merge.host = "third".into();
-        assert_eq!(merge_pair(&s).unwrap(), ("third".to_string(), a));
+        assert_eq!(merge_pair(&s).unwrap().unwrap(), ("third".to_string(), a));
     }
 }

@@ -6,12 +6,15 @@
 //! recording asked for, `record` hands the rerun recorder plain data along the way.
 
 mod agent;
+mod coordinate;
+mod coverage;
 mod drive;
 mod evaluate;
 mod merge;
 mod options;
 mod outputs;
 mod record;
+mod team;
 
 pub use options::{RobotStep, RunError, RunOptions, RunOutput, StepTap};
 pub use outputs::{merge_overlay, output_files, write_outputs};
@@ -42,7 +45,7 @@ pub fn merger_for(algorithm: Algorithm, scenario: &Scenario) -> MergerConfig {
 /// algorithm and every merge is scored against the true transform (`merge_maps`).
 pub fn run(scenario: &Scenario, mut opts: RunOptions) -> Result<RunOutput, RunError> {
     let wall = Instant::now();
-    let (host, other) = merge::merge_pair(scenario)?;
+    let pair = merge::merge_pair(scenario)?;
     let config = SimConfig { dt: scenario.dt, ..SimConfig::default() };
     let mut sim = Sim::with_config(&scenario.world, scenario.seed, config)?;
     let truth = sim.true_map(scenario.truth_resolution)?;
@@ -51,7 +54,8 @@ pub fn run(scenario: &Scenario, mut opts: RunOptions) -> Result<RunOutput, RunEr
     if let Some(v) = opts.viz.as_deref_mut() {
         record::viz_begin(v, &sim, &truth, &agents, &algorithms);
     }
-    let steps = drive::drive(scenario, &mut sim, &mut agents, &truth, &mut opts)?;
+    let mut teams = scenario.team.as_ref().map(|setup| team::Teams::new(scenario, setup, &truth));
+    let steps = drive::drive(scenario, &mut sim, &mut agents, &truth, teams.as_mut(), &mut opts)?;
     let merge_at = sim.time();
     if let Some(v) = opts.viz.as_deref_mut() {
         v.set_time(steps, merge_at);
@@ -61,12 +65,16 @@ pub fn run(scenario: &Scenario, mut opts: RunOptions) -> Result<RunOutput, RunEr
     for a in agents.iter_mut() {
         a.slam.finish();
     }
+    let team = teams.map(|t| t.report(merge_at, &agents, &truth)).transpose()?;
     let evaluated = evaluate::evaluate_robots(&agents, &truth, &mut opts)?;
-    let mergers: Vec<(Algorithm, Box<dyn Merger>)> =
-        algorithms.iter().map(|&a| (a, merger_for(a, scenario).build())).collect();
-    let pair = (host.as_str(), other.as_str());
-    let (results, merges) = merge::merge_maps(scenario, &mergers, &evaluated, pair, &truth, &mut opts);
-    let observed_overlap = merge::observed_overlap(&agents, pair);
+    let (mut results, mut merges, mut observed_overlap) = (Vec::new(), Vec::new(), 0.0);
+    if let Some((host, other)) = &pair {
+        let mergers: Vec<(Algorithm, Box<dyn Merger>)> =
+            algorithms.iter().map(|&a| (a, merger_for(a, scenario).build())).collect();
+        let pair = (host.as_str(), other.as_str());
+        (results, merges) = merge::merge_maps(scenario, &mergers, &evaluated, pair, &truth, &mut opts);
+        observed_overlap = merge::observed_overlap(&agents, pair);
+    }
     let report = RunReport {
         scenario: scenario.name.clone(),
         seed: scenario.seed,
@@ -74,10 +82,11 @@ pub fn run(scenario: &Scenario, mut opts: RunOptions) -> Result<RunOutput, RunEr
         wall_s: wall.elapsed().as_secs_f64(),
         steps,
         merge_at_s: merge_at,
-        merge_pair: [host, other],
+        merge_pair: pair.map(|(host, other)| [host, other]),
         robots: evaluated.robots,
         merges: results,
         observed_overlap,
+        team,
     };
     Ok(RunOutput { report, maps: evaluated.maps, truth, merges, frames: evaluated.frames, paths: evaluated.paths })
 }

@@ -10,8 +10,10 @@ use std::path::{Path, PathBuf};
 /// The picture of a merge: the true map in grey, the host robot's map (blue) at its true frame, the other's
 /// (orange) placed by the merge's estimate `t_a_b` from there, each with its SLAM path: where the estimate is
 /// right, both robots' walls lie on the truth's.
+///
+/// A run without a merge pair (a team of one robot) shows the truth alone.
 pub fn merge_overlay(out: &RunOutput, t_a_b: &Pose2) -> image::RgbImage {
-    let [host, other] = &out.report.merge_pair;
+    let Some([host, other]) = &out.report.merge_pair else { return map_io::overlay(&out.truth, &[]) };
     let frame = out.frames.get(host).copied().unwrap_or_else(Pose2::identity);
     let layer = |name: &String, placement: Pose2, colour: [u8; 3]| {
         out.maps.get(name).map(|map| map_io::OverlayLayer {

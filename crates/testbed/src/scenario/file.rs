@@ -19,6 +19,7 @@ pub(super) struct ScenarioFile {
     pub(super) merge: MergeFile,
     #[serde(default)]
     pub(super) success: SuccessFile,
+    pub(super) team: Option<TeamFile>,
 }
 
 /// A pose: a named point of the world, `[x, y, theta]` or a table `{ x, y, theta }` as world files write
@@ -141,4 +142,17 @@ pub(super) struct MergeFile {
 pub(super) struct SuccessFile {
     pub(super) rotation_deg: Option<f64>,
     pub(super) translation_m: Option<f64>,
+}
+
+/// The `[team]` table.
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub(super) struct TeamFile {
+    pub(super) range: Option<f64>,
+    pub(super) line_of_sight: Option<bool>,
+    pub(super) exchange_period: Option<f64>,
+    pub(super) coordination: Option<String>,
+    pub(super) merger: Option<String>,
+    pub(super) coverage_period: Option<f64>,
+    pub(super) beta: Option<f64>,
 }

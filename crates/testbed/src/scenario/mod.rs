@@ -8,10 +8,12 @@ mod error;
 mod file;
 mod merge;
 mod robot;
+mod team;
 
 pub use error::{ScenarioError, at};
 pub use merge::{MergeSetup, MergeWhen};
 pub use robot::{ControllerKind, RobotSetup};
+pub use team::{Coordination, TeamSetup};
 
 use error::Ctx;
 use file::ScenarioFile;
@@ -55,6 +57,9 @@ pub struct Scenario {
     pub merge: MergeSetup,
     /// Success thresholds.
     pub success: Success,
+    /// The `[team]` table: robots merge their maps while they drive and may explore together; `None` merges
+    /// once, after driving, as the paper does.
+    pub team: Option<TeamSetup>,
 }
 
 impl Scenario {
@@ -89,11 +94,16 @@ impl Scenario {
         if !(truth_resolution > 0.0 && truth_resolution.is_finite()) {
             return Err(cx.err("truth_resolution", "must be positive"));
         }
-        // A run merges two maps, so it needs two robots at least.
-        if file.robots.len() < 2 {
+        // A run merges two maps, so it needs two robots at least; a team may be one robot (a study's baseline).
+        let team = file.team.as_ref().map(|t| team::resolve_team(&cx, t)).transpose()?;
+        let fewest = if team.is_some() { 1 } else { 2 };
+        if file.robots.len() < fewest {
             return Err(cx.err(
                 "robots",
-                format!("need at least two robots (a merge takes two maps), found {}", file.robots.len()),
+                match team {
+                    None => format!("need at least two robots (a merge takes two maps), found {}", file.robots.len()),
+                    Some(_) => "a team needs at least one robot, found none".to_string(),
+                },
             ));
         }
         let robots = file
@@ -148,6 +158,7 @@ impl Scenario {
             robots,
             merge,
             success,
+            team,
         })
     }
 }
