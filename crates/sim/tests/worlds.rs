@@ -212,5 +212,5 @@ fn a_bitmaps_unknown_cells_may_be_walls_so_the_building_is_closed() {
     assert!(open.cast_ray(&inside, 0.0, 10.0).is_none());
     // Anything else names the field and the line.
     let e = world_at("unknown = \"walls\"").unwrap_err().to_string();
-    assert!(e.contains("w.toml:2: bitmap.unknown: expected \"free\" or \"occupied\""), "{e}");
+    assert!(e.contains("w.toml:2: field `bitmap.unknown`: expected \"free\" or \"occupied\""), "{e}");
 }
