@@ -54,7 +54,10 @@ pub fn run(scenario: &Scenario, mut opts: RunOptions) -> Result<RunOutput, RunEr
     if let Some(v) = opts.viz.as_deref_mut() {
         record::viz_begin(v, &sim, &truth, &agents, &algorithms);
     }
-    let mut teams = scenario.team.as_ref().map(|setup| team::Teams::new(scenario, setup, &truth));
+    let mut teams = scenario
+        .team
+        .as_ref()
+        .map(|setup| team::Teams::new(scenario, setup, &truth, merger_for(setup.merger, scenario).build()));
     let steps = drive::drive(scenario, &mut sim, &mut agents, &truth, teams.as_mut(), &mut opts)?;
     let merge_at = sim.time();
     if let Some(v) = opts.viz.as_deref_mut() {

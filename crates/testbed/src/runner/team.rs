@@ -16,7 +16,7 @@ use crate::eval::{map_acceptance, transform_error};
 use crate::report::{MergeAttempt, TeamPlan, TeamReport};
 use crate::scenario::{Coordination, Scenario, Success, TeamSetup};
 use mrslam_core::{CellTraversal, OccupancyGrid, Pose2};
-use mrslam_merge::{MergeParams, Merger, MergerConfig, fuse_maps as fuse, merge};
+use mrslam_merge::{MergeParams, Merger, fuse_maps as fuse, merge};
 use nalgebra::Point2;
 use std::collections::BTreeMap;
 
@@ -74,24 +74,21 @@ pub(super) struct Teams<'s> {
 }
 
 impl<'s> Teams<'s> {
-    /// Every robot a team of its own; the reachable free area of `truth` from the robots' starts.
-    pub(super) fn new(scenario: &Scenario, setup: &'s TeamSetup, truth: &OccupancyGrid) -> Self {
+    /// Every robot a team of its own, merging with `merger`; the reachable free area of `truth` from the robots'
+    /// starts.
+    pub(super) fn new(
+        scenario: &Scenario,
+        setup: &'s TeamSetup,
+        truth: &OccupancyGrid,
+        merger: Box<dyn Merger>,
+    ) -> Self {
         let n = scenario.robots.len();
         let starts: Vec<Pose2> = scenario.robots.iter().map(|r| r.start).collect();
         let radius = scenario.robots.iter().map(|r| r.model.footprint.bounding_radius()).fold(f64::INFINITY, f64::min);
-        let config = MergerConfig {
-            model: scenario.merge.model,
-            encoding: scenario.merge.encoding,
-            ratio: scenario.merge.ratio,
-            candidates: scenario.merge.candidates,
-            hypotheses: scenario.merge.hypotheses,
-            wall_dilation: scenario.merge.wall_dilation,
-            ..MergerConfig::new(setup.merger, scenario.seed)
-        };
         Teams {
             setup,
             success: scenario.success,
-            merger: config.build(),
+            merger,
             params: MergeParams::default(),
             root: (0..n).collect(),
             place: vec![Pose2::identity(); n],
