@@ -57,6 +57,19 @@ fn robots_out_of_range_never_try_to_merge() {
 }
 
 #[test]
+fn robots_whose_maps_know_too_little_never_try_to_merge() {
+    // In range all along, but the rooms hold under 40 m² of free space: no map reaches 1000 m².
+    let r = run_team_two_rooms(|t| {
+        t.replace("merger = \"cascade\"", "merger = \"cascade\"\nmin_known_m2 = 1000.0")
+            .replace("duration = 150.0", "duration = 40.0")
+    });
+    let team = r.team.as_ref().expect("a team report");
+    assert!(team.attempts.is_empty(), "{:?}", team.attempts);
+    assert_eq!(team.bytes_exchanged, 0, "no map is sent before a merge is tried");
+    assert_eq!(team.teams.len(), 2, "{:?}", team.teams);
+}
+
+#[test]
 fn a_team_scenarios_bad_robot_is_refused_with_file_and_line() {
     let (path, text) = shipped("team_fr079");
     let line_of = |t: &str, needle: &str| t.lines().position(|l| l.contains(needle)).unwrap() + 1;

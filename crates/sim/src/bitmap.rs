@@ -80,6 +80,51 @@ pub fn occupied_obstacles(grid: &OccupancyGrid) -> Vec<Obstacle> {
         .collect()
 }
 
+/// Frees the occupied cells of `grid` that lie in 8-connected groups of fewer than `min_cells` cells: the specks
+/// a SLAM map keeps in open space (a person walking by, a beam's noise) where the map's robot drove freely.
+/// Returns the number of cells freed.
+pub fn drop_specks(grid: &mut OccupancyGrid, min_cells: usize) -> usize {
+    let (w, h) = (grid.width(), grid.height());
+    let free = -mrslam_core::map_io::ROS_LOGODDS_LIMIT;
+    let occupied: Vec<bool> =
+        grid.cells().iter().map(|&l| CellState::from_log_odds(l) == CellState::Occupied).collect();
+    let mut seen = vec![false; w * h];
+    let (mut group, mut stack, mut freed) = (Vec::new(), Vec::new(), 0);
+    for seed in 0..w * h {
+        if !occupied[seed] || seen[seed] {
+            continue;
+        }
+        seen[seed] = true;
+        group.clear();
+        stack.push(seed);
+        while let Some(c) = stack.pop() {
+            group.push(c);
+            let (cx, cy) = ((c % w) as i64, (c / w) as i64);
+            for dy in -1..=1i64 {
+                for dx in -1..=1i64 {
+                    let (x, y) = (cx + dx, cy + dy);
+                    if x < 0 || y < 0 || x >= w as i64 || y >= h as i64 {
+                        continue;
+                    }
+                    let n = y as usize * w + x as usize;
+                    if occupied[n] && !seen[n] {
+                        seen[n] = true;
+                        stack.push(n);
+                    }
+                }
+            }
+        }
+        if group.len() < min_cells {
+            let cells = grid.cells_mut();
+            for &c in &group {
+                cells[c] = free;
+            }
+            freed += group.len();
+        }
+    }
+    freed
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -129,5 +174,23 @@ mod tests {
         // cell (0, 1) spans x in [1, 1.5], y in [2.5, 3]
         assert!(obs[0].contains(&Point2::new(1.25, 2.75)));
         assert!(!obs[0].contains(&Point2::new(1.75, 2.75)));
+    }
+
+    #[test]
+    fn specks_are_freed_and_walls_kept() {
+        // A 2-cell speck, a lone cell on the border and a 10-cell wall on a 20 x 20 free grid.
+        let mut g = OccupancyGrid::new(20, 20, 0.05, mrslam_core::pose(0.0, 0.0, 0.0)).unwrap();
+        g.cells_mut().fill(-2.0);
+        for (x, y) in [(5, 5), (6, 6), (0, 19)] {
+            g.set(x, y, 2.0);
+        }
+        for x in 5..15 {
+            g.set(x, 12, 2.0);
+        }
+        assert_eq!(drop_specks(&mut g, 4), 3);
+        assert_eq!(g.state(5, 5), CellState::Free);
+        assert_eq!(g.state(0, 19), CellState::Free);
+        assert!((5..15).all(|x| g.state(x, 12) == CellState::Occupied));
+        assert_eq!(drop_specks(&mut g, 11), 10, "a group of 10 cells is a speck when 11 are asked for");
     }
 }

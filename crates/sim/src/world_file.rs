@@ -19,6 +19,7 @@
 //! [bitmap]                       # optional: a ROS map_server map; occupied cells become obstacles
 //! map = "floor.yaml"             # relative to the world file
 //! unknown = "free"               # the map's unknown cells: "free" (default) or "occupied" (a closed building)
+//! min_obstacle_cells = 1         # occupied groups of fewer cells are freed (specks a SLAM map keeps); default 1
 //! ```
 
 use crate::error::SimError;
@@ -103,6 +104,7 @@ impl NamedPoint {
 struct BitmapSpec {
     map: String,
     unknown: Option<String>,
+    min_obstacle_cells: Option<usize>,
 }
 
 /// A loaded bitmap layer: a ROS map whose occupied cells are obstacles.
@@ -295,6 +297,10 @@ impl WorldSpec {
                     .iter_mut()
                     .filter(|l| **l == 0.0)
                     .for_each(|l| *l = mrslam_core::map_io::ROS_LOGODDS_LIMIT);
+            }
+            // After closing: an unknown hole between beams, walled by the step above, is a speck too.
+            if let Some(min) = b.min_obstacle_cells {
+                crate::bitmap::drop_specks(&mut grid, min);
             }
             spec.bitmap = Some(BitmapLayer { map, grid });
         }

@@ -30,15 +30,15 @@ fn radius_cells(metres: f64, resolution: f64) -> i64 {
 }
 
 /// True when cell (x, y) is a frontier cell: free, with at least [`FRONTIER_MIN_UNKNOWN`] unknown neighbours.
+///
+/// Cells beyond the grid are unknown: a map holds only what was seen, so a free cell on its edge borders the
+/// unseen (behind a robot whose lidar sees only ahead, above all).
 fn is_frontier_cell(map: &OccupancyGrid, x: i64, y: i64) -> bool {
-    let state = |x: i64, y: i64| map.get_checked(x, y).map(CellState::from_log_odds);
-    if state(x, y) != Some(CellState::Free) {
+    let state = |x: i64, y: i64| map.get_checked(x, y).map_or(CellState::Unknown, CellState::from_log_odds);
+    if !map.contains_cell(x, y) || state(x, y) != CellState::Free {
         return false;
     }
-    let unknown = (-1..=1)
-        .flat_map(|dy| (-1..=1).map(move |dx| (dx, dy)))
-        .filter(|&(dx, dy)| state(x + dx, y + dy) == Some(CellState::Unknown))
-        .count();
+    let unknown = AROUND.iter().filter(|&&(dx, dy)| state(x + dx, y + dy) == CellState::Unknown).count();
     unknown >= FRONTIER_MIN_UNKNOWN
 }
 
@@ -324,7 +324,8 @@ pub fn frontiers(
     // Each cell classified once: the frontier test below reads its eight neighbours for every free cell.
     let cells = map.cells();
     let unknown: Vec<bool> = cells.iter().map(|&l| CellState::from_log_odds(l) == CellState::Unknown).collect();
-    let unknown_at = |x: i64, y: i64| map.contains_cell(x, y) && unknown[y as usize * w + x as usize];
+    // Beyond the grid is unknown, as in `is_frontier_cell`.
+    let unknown_at = |x: i64, y: i64| !map.contains_cell(x, y) || unknown[y as usize * w + x as usize];
     let mut mark = vec![false; w * h];
     for iy in 0..h {
         for ix in 0..w {
@@ -471,6 +472,26 @@ mod tests {
             }
         }
         assert!(frontier_path(&g, &pose(1.05, 1.0, 0.0), 0.3, &[], 0.0).is_none());
+    }
+
+    #[test]
+    fn a_map_that_ends_behind_the_robot_has_its_frontier_on_the_edge() {
+        // A SLAM map holds only what was seen: a robot with a forward-looking lidar facing a dead end (a 2 m
+        // corridor closed 3 m ahead) stands on the grid's west edge, and the corridor behind it is off the grid.
+        let mut g = grid(60, 40);
+        for iy in 0..40 {
+            for ix in 0..60 {
+                let wall = iy == 0 || iy == 39 || ix == 59;
+                g.set(ix, iy, if wall { 2.0 } else { -2.0 });
+            }
+        }
+        let path = frontier_path(&g, &pose(0.02, 1.0, 0.0), 0.3, &[], 0.0).expect("the corridor behind the robot");
+        let end = path.last().unwrap();
+        assert!(end.x < 0.1, "the goal is on the west edge: {end:?}");
+        let walls = WallDistance::new(&g);
+        let clusters = frontiers(&g, &walls, 0.3, &Skip::default(), MIN_CLUSTER_CELLS);
+        assert_eq!(clusters.len(), 1, "{clusters:?}");
+        assert!(clusters[0].target.x < 0.1, "{clusters:?}");
     }
 
     #[test]

@@ -195,6 +195,9 @@ impl<'s> Teams<'s> {
             let (Some(map_a), Some(map_b)) = (self.team_map(ra, &snapshot), self.team_map(rb, &snapshot)) else {
                 continue;
             };
+            if known_m2(&map_a).min(known_m2(&map_b)) < self.setup.min_known_m2 {
+                continue;
+            }
             self.bytes += message_bytes(&map_a) + message_bytes(&map_b);
             let out = merge(self.merger.as_ref(), &map_a, &map_b, &self.params);
             let (fa, fb) = (frames[ra].unwrap_or_default(), frames[rb].unwrap_or_default());
@@ -300,6 +303,12 @@ impl<'s> Teams<'s> {
             plans: self.plans,
         })
     }
+}
+
+/// The area `map` knows (free or occupied), m².
+fn known_m2(map: &OccupancyGrid) -> f64 {
+    let (free, occupied, _) = map.state_counts();
+    (free + occupied) as f64 * map.resolution() * map.resolution()
 }
 
 /// An unknown grid with `map`'s geometry (the fusion's frame when a team's root has no map yet).

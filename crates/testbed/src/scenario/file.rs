@@ -155,4 +155,5 @@ pub(super) struct TeamFile {
     pub(super) merger: Option<String>,
     pub(super) coverage_period: Option<f64>,
     pub(super) beta: Option<f64>,
+    pub(super) min_known_m2: Option<f64>,
 }

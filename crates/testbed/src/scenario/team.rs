@@ -63,6 +63,10 @@ pub struct TeamSetup {
     pub coverage_period: f64,
     /// Weight of travel cost against information gain in the frontier assignment (Burgard et al.'s beta).
     pub beta: f64,
+    /// Robots in contact exchange maps and try to merge them only once both teams' maps know this much area,
+    /// m² (0: from the first scan). Maps of a scan or two match a corridor's other doors as well as the right
+    /// ones; the correlative stage asks for 100 m² of shared known space for the same reason.
+    pub min_known_m2: f64,
 }
 
 impl Default for TeamSetup {
@@ -75,6 +79,7 @@ impl Default for TeamSetup {
             merger: Algorithm::Cascade,
             coverage_period: 2.0,
             beta: 1.0,
+            min_known_m2: 0.0,
         }
     }
 }
@@ -109,5 +114,6 @@ pub(super) fn resolve_team(cx: &Ctx, t: &TeamFile) -> Result<TeamSetup, Scenario
         merger,
         coverage_period: positive("coverage_period", t.coverage_period, d.coverage_period)?,
         beta: non_negative("beta", t.beta, d.beta)?,
+        min_known_m2: non_negative("min_known_m2", t.min_known_m2, d.min_known_m2)?,
     })
 }
