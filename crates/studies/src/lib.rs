@@ -31,6 +31,7 @@
 // `journal`, `logs`, `overlap`, `plot`, `results` and `summary` are public namespaces (their items are not
 // re-exported); the other modules are private, their items re-exported below: each item has one path.
 mod algorithms;
+mod csv_row;
 mod error;
 pub mod journal;
 pub mod logs;
@@ -47,6 +48,7 @@ mod trial;
 mod wilson;
 
 pub use algorithms::{check_algorithms, parse_algorithms};
+pub use csv_row::CsvRow;
 pub use error::StudyError;
 pub use outputs::write_outputs;
 pub use progress::Progress;
