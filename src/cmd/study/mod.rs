@@ -1,12 +1,13 @@
 //! `mrslam study`: many seeded merge trials across overlaps — map level (`overlap`), simulation level
-//! (`scenario`), real data (`logs`: a real log split in time into robots), and joining the shards of a study
-//! split across machines (`collect`). One module per subcommand; the progress, resume and output helpers they
-//! share here.
+//! (`scenario`), real data (`logs`: a real log split in time into robots) — team exploration over numbers of
+//! robots, ranges, coordinations and mergers (`team`), and joining the shards of a study split across machines
+//! (`collect`). One module per subcommand; the progress, resume and output helpers they share here.
 
 mod collect;
 mod logs;
 mod overlap;
 mod scenario;
+mod team;
 
 use crate::cmd::{Outputs, kind};
 use anyhow::{Context, Result, bail};
@@ -34,6 +35,9 @@ pub enum StudyCommand {
     /// Real-data study: split a CARMEN log in time into N robots, map each with the SLAM, merge every pair
     /// the relations connect with each algorithm, score against the relations.
     Logs(logs::LogsArgs),
+    /// Team study: run a team scenario with the first N robots, each range, coordination and online merger, and
+    /// each seed; coverage over time, time to 90 %, redundancy and online merges per configuration.
+    Team(team::TeamArgs),
 }
 
 /// Runs `mrslam study`.
@@ -43,6 +47,7 @@ pub fn run(cmd: StudyCommand) -> Result<ExitCode> {
         StudyCommand::Scenario(a) => scenario::run(a),
         StudyCommand::Collect(a) => collect::run(a),
         StudyCommand::Logs(a) => logs::run(a),
+        StudyCommand::Team(a) => team::run(a),
     }
 }
 
