@@ -258,6 +258,27 @@ pub(crate) mod tests {
     }
 
     #[test]
+    fn an_interrupted_team_study_resumes_with_its_whole_rows() {
+        use crate::journal::{Journal, RESULTS_FILE, StudyParams};
+        use std::io::Write as _;
+        let dir = tempfile::tempdir().unwrap();
+        let mut params = StudyParams::default();
+        params.set("kind", "team");
+        let (j, done) = Journal::<TeamRow>::open(dir.path(), &params, 1, false).unwrap();
+        assert!(done.is_empty());
+        let rows: Vec<TeamRow> = (0..3).map(|t| row(t, 1, Coordination::None, None)).collect();
+        j.append(&rows[..2]).unwrap(); // one run's two trials in one write
+        drop(j);
+        // The third trial's row cut off in the middle.
+        let mut f = std::fs::OpenOptions::new().append(true).open(dir.path().join(RESULTS_FILE)).unwrap();
+        f.write_all(&rows[2].to_csv().as_bytes()[..40]).unwrap();
+        drop(f);
+        let (_, done) = Journal::<TeamRow>::open(dir.path(), &params, 1, true).unwrap();
+        assert_eq!(done, rows[..2]);
+        assert_eq!(read_team_results(&dir.path().join(RESULTS_FILE)).unwrap(), rows[..2]);
+    }
+
+    #[test]
     fn collect_joins_shards_and_refuses_a_trial_twice() {
         let dir = tempfile::tempdir().unwrap();
         let (a, b) = (dir.path().join("a"), dir.path().join("b"));
