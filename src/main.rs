@@ -52,7 +52,8 @@ enum Command {
     /// Simulated worlds: make one from a map.
     #[command(subcommand)]
     World(cmd::world::WorldCommand),
-    /// Studies: many seeded merge trials across overlaps; success rates with intervals, plots, shards.
+    /// Studies: many seeded merge trials across overlaps, or team runs across robots, ranges and coordinations;
+    /// rates and means with intervals, plots, shards.
     #[command(subcommand)]
     Study(cmd::study::StudyCommand),
 }

@@ -19,6 +19,7 @@ mod slam;
 mod slam_bags;
 mod study;
 mod study_logs;
+mod study_team;
 mod util;
 mod viz;
 mod world;

@@ -3,9 +3,10 @@
 //! `--resume` continues it. `collect` compares the shards' `study.json` and refuses shards of other studies.
 
 use super::StudyError;
-use super::results::{HEADER, TrialRow};
+use super::csv_row::{CsvRow, parse_rows, rows_text};
 use std::collections::{BTreeMap, BTreeSet};
 use std::io::Write as _;
+use std::marker::PhantomData;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
@@ -149,13 +150,14 @@ pub fn collect_params(dirs: &[PathBuf], partial: bool) -> Result<(Option<StudyPa
     Ok((first.and_then(|(_, p)| p), missing))
 }
 
-/// The `results.csv` of a running study, appended to trial by trial.
-pub struct Journal {
+/// The `results.csv` of a running study, appended to trial by trial with rows of type `R`.
+pub struct Journal<R> {
     path: PathBuf,
     file: Mutex<std::fs::File>,
+    rows: PhantomData<fn(&R)>,
 }
 
-impl Journal {
+impl<R: CsvRow> Journal<R> {
     /// Opens `dir` for the study `params` whose trials write `rows_per_trial` rows each.
     ///
     /// Fresh (`resume` false): refuses a folder that already holds a `results.csv`, so no result is lost to
@@ -166,7 +168,7 @@ impl Journal {
         params: &StudyParams,
         rows_per_trial: usize,
         resume: bool,
-    ) -> Result<(Journal, Vec<TrialRow>), StudyError> {
+    ) -> Result<(Journal<R>, Vec<R>), StudyError> {
         std::fs::create_dir_all(dir).map_err(|e| StudyError::file(dir, e))?;
         let path = dir.join(RESULTS_FILE);
         let done = if resume {
@@ -193,18 +195,14 @@ impl Journal {
             Vec::new()
         };
         // Start the file anew with the header and the complete trials, then append.
-        let mut text = format!("{HEADER}\n");
-        for r in &done {
-            text += &r.to_csv();
-            text.push('\n');
-        }
+        let text = rows_text(&done);
         mrslam_core::output::write_file_atomic(&path, text.as_bytes()).map_err(|e| StudyError::file(&path, e))?;
         let file = std::fs::OpenOptions::new().append(true).open(&path).map_err(|e| StudyError::file(&path, e))?;
-        Ok((Journal { path, file: Mutex::new(file) }, done))
+        Ok((Journal { path, file: Mutex::new(file), rows: PhantomData }, done))
     }
 
-    /// Appends one trial's rows in one write and flushes them to the file.
-    pub fn append(&self, rows: &[TrialRow]) -> Result<(), StudyError> {
+    /// Appends the rows of one or more finished trials in one write and flushes them to the file.
+    pub fn append(&self, rows: &[R]) -> Result<(), StudyError> {
         let mut text = String::new();
         for r in rows {
             text += &r.to_csv();
@@ -217,41 +215,25 @@ impl Journal {
 
 /// The rows of the trials `text` holds completely: lines cut off, and trials with fewer than
 /// `rows_per_trial` rows, are dropped.
-fn complete_trials(text: &str, path: &Path, rows_per_trial: usize) -> Result<Vec<TrialRow>, StudyError> {
+fn complete_trials<R: CsvRow>(text: &str, path: &Path, rows_per_trial: usize) -> Result<Vec<R>, StudyError> {
     // Only lines that end in a newline were written completely.
     let whole = &text[..text.rfind('\n').map_or(0, |i| i + 1)];
-    let mut lines = whole.lines().enumerate();
-    match lines.next() {
-        None => return Ok(Vec::new()),
-        Some((_, h)) if h.trim() == HEADER => {}
-        Some((_, h)) => {
-            return Err(StudyError::Results {
-                path: path.to_path_buf(),
-                line: 1,
-                message: format!("header `{}` is not the expected `{HEADER}`", h.trim()),
-            });
-        }
+    if whole.trim().is_empty() {
+        return Ok(Vec::new());
     }
-    let mut rows = Vec::new();
-    for (i, l) in lines.filter(|(_, l)| !l.trim().is_empty()) {
-        let r = TrialRow::from_csv(l).map_err(|message| StudyError::Results {
-            path: path.to_path_buf(),
-            line: i + 1,
-            message,
-        })?;
-        rows.push(r);
-    }
+    let mut rows: Vec<R> = parse_rows(whole, path)?.into_iter().map(|(_, r)| r).collect();
     let mut count: BTreeMap<usize, usize> = BTreeMap::new();
     for r in &rows {
-        *count.entry(r.trial).or_default() += 1;
+        *count.entry(r.trial()).or_default() += 1;
     }
-    rows.retain(|r| count[&r.trial] == rows_per_trial);
+    rows.retain(|r| count[&r.trial()] == rows_per_trial);
     Ok(rows)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::results::TrialRow;
 
     #[test]
     fn collecting_some_shards_of_a_study_is_refused_naming_the_missing_ones() {
@@ -301,7 +283,7 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let mut params = StudyParams::default();
         params.set("seed", 5);
-        let (j, done) = Journal::open(dir.path(), &params, 2, false).unwrap();
+        let (j, done) = Journal::<TrialRow>::open(dir.path(), &params, 2, false).unwrap();
         assert!(done.is_empty());
         j.append(&[row(0, "sift"), row(0, "rmap")]).unwrap();
         j.append(&[row(3, "sift")]).unwrap(); // a trial cut off after its first row
@@ -312,12 +294,12 @@ mod tests {
         f.write_all(b"4,0.2,0.2").unwrap();
         drop(f);
         // A fresh start in the folder is refused; a resume of another study too.
-        assert!(Journal::open(dir.path(), &params, 2, false).is_err());
+        assert!(Journal::<TrialRow>::open(dir.path(), &params, 2, false).is_err());
         let mut other = params.clone();
         other.set("seed", 6);
-        let e = Journal::open(dir.path(), &other, 2, true).err().unwrap().to_string();
+        let e = Journal::<TrialRow>::open(dir.path(), &other, 2, true).err().unwrap().to_string();
         assert!(e.contains("`seed` is `5` there but `6` here"), "{e}");
-        let (_, done) = Journal::open(dir.path(), &params, 2, true).unwrap();
+        let (_, done) = Journal::<TrialRow>::open(dir.path(), &params, 2, true).unwrap();
         assert_eq!(done, vec![row(0, "sift"), row(0, "rmap")]);
         assert_eq!(std::fs::read_to_string(&path).unwrap().lines().count(), 3, "the file holds what was kept");
     }

@@ -12,6 +12,11 @@
 //! part with the SLAM, merges the pairs that benchmark relations connect and scores them against the
 //! relations; it writes its own `results.csv` columns (one row per pair and algorithm).
 //!
+//! A fourth kind, **team studies** ([`team`]), runs a team scenario (robots that merge their maps while they
+//! drive) over numbers of robots, communication ranges, coordinations and online mergers, and reports coverage over
+//! time, time to 90 % coverage and redundancy per configuration with Student t 95 % intervals (`student_t`); it
+//! too writes its own `results.csv` columns (one row per trial).
+//!
 //! Rows go to `results.csv` ([`results`]); [`summary`] bins them by overlap with Wilson intervals
 //! (`wilson`) into `summary.csv`; [`plot`] draws `plot.png`. `shard` splits one study across processes
 //! and [`results::collect`] joins the shards again. Every trial is seeded from (study seed, overlap index,
@@ -28,11 +33,13 @@
 
 #![deny(missing_docs)]
 
-// `journal`, `logs`, `overlap`, `plot`, `results` and `summary` are public namespaces (their items are not
-// re-exported); the other modules are private, their items re-exported below: each item has one path.
+// `journal`, `logs`, `overlap`, `plot`, `results`, `summary` and `team` are public namespaces (their items are
+// not re-exported); the other modules are private, their items re-exported below: each item has one path.
 mod algorithms;
+mod csv_row;
 mod error;
 pub mod journal;
+mod list;
 pub mod logs;
 mod outputs;
 pub mod overlap;
@@ -41,16 +48,21 @@ mod progress;
 mod range;
 pub mod results;
 mod shard;
+mod student_t;
 pub mod summary;
 mod sweep;
+pub mod team;
 mod trial;
 mod wilson;
 
 pub use algorithms::{check_algorithms, parse_algorithms};
+pub use csv_row::CsvRow;
 pub use error::StudyError;
+pub use list::{parse_numbers, parse_whole_numbers};
 pub use outputs::write_outputs;
 pub use progress::Progress;
 pub use range::parse_range;
 pub use shard::Shard;
+pub use student_t::{MeanCi, mean_ci, t_quantile};
 pub use sweep::{Sweep, run_sweep};
 pub use wilson::{Z95, wilson_interval};

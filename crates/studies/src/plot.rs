@@ -14,7 +14,8 @@ pub const WIDTH: u32 = 1200;
 /// Height of `plot.png`, pixels.
 pub const HEIGHT: u32 = 900;
 
-const COLOURS: [RGBColor; 6] = [
+/// The colours of the lines, in order (matplotlib's first six).
+pub(crate) const COLOURS: [RGBColor; 6] = [
     RGBColor(31, 119, 180),
     RGBColor(214, 39, 40),
     RGBColor(44, 160, 44),

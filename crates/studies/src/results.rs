@@ -7,8 +7,8 @@
 //! map-level studies (a cut pair has no SLAM drift: its truth is exact). Booleans are `true`/`false`.
 
 use super::StudyError;
+use super::csv_row::{CsvRow, parse_rows, read_rows, write_rows};
 use std::collections::BTreeMap;
-use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 /// The header line of `results.csv`.
@@ -56,9 +56,15 @@ fn opt(v: Option<f64>, digits: usize) -> String {
     v.map_or(String::new(), |x| format!("{x:.digits$}"))
 }
 
-impl TrialRow {
-    /// The row as a CSV line (no newline). Every column but `time_ms` is a pure function of the trial.
-    pub fn to_csv(&self) -> String {
+/// Every column but `time_ms` is a pure function of the trial.
+impl CsvRow for TrialRow {
+    const HEADER: &'static str = HEADER;
+
+    fn trial(&self) -> usize {
+        self.trial
+    }
+
+    fn to_csv(&self) -> String {
         format!(
             "{},{},{:.6},{},{},{},{},{},{},{},{:.3},{},{},{}",
             self.trial,
@@ -78,8 +84,7 @@ impl TrialRow {
         )
     }
 
-    /// Parses a CSV line written by [`TrialRow::to_csv`].
-    pub fn from_csv(line: &str) -> Result<TrialRow, String> {
+    fn from_csv(line: &str) -> Result<TrialRow, String> {
         let f: Vec<&str> = line.split(',').map(str::trim).collect();
         if f.len() != COLUMNS {
             return Err(format!("expected {COLUMNS} columns, found {}", f.len()));
@@ -128,44 +133,17 @@ pub fn sort_rows<S: AsRef<str>>(rows: &mut [TrialRow], order: &[S]) {
 
 /// Writes `results.csv`.
 pub fn write_results(rows: &[TrialRow], path: &Path) -> Result<(), StudyError> {
-    let mut s = String::with_capacity(80 * (rows.len() + 1));
-    s.push_str(HEADER);
-    s.push('\n');
-    for r in rows {
-        let _ = writeln!(s, "{}", r.to_csv());
-    }
-    mrslam_core::output::write_file_atomic(path, s.as_bytes()).map_err(|e| StudyError::file(path, e))
+    write_rows(rows, path)
 }
 
 /// Reads a `results.csv`, checking its header.
 pub fn read_results(path: &Path) -> Result<Vec<TrialRow>, StudyError> {
-    Ok(read_numbered(path)?.into_iter().map(|(_, r)| r).collect())
-}
-
-/// Reads a `results.csv` with each row's 1-based line.
-fn read_numbered(path: &Path) -> Result<Vec<(usize, TrialRow)>, StudyError> {
-    let text = mrslam_core::input::read_text_limited(path, mrslam_core::input::DATA_LIMIT)
-        .map_err(|e| StudyError::file(path, e))?;
-    parse_numbered(&text, path)
+    Ok(read_rows(path)?.into_iter().map(|(_, r)| r).collect())
 }
 
 /// Parses the text of a `results.csv`, checking its header; `path` only names it in errors.
 pub fn parse_results(text: &str, path: &Path) -> Result<Vec<TrialRow>, StudyError> {
-    Ok(parse_numbered(text, path)?.into_iter().map(|(_, r)| r).collect())
-}
-
-fn parse_numbered(text: &str, path: &Path) -> Result<Vec<(usize, TrialRow)>, StudyError> {
-    let err = |line: usize, message: String| StudyError::Results { path: path.to_path_buf(), line, message };
-    let mut lines = text.lines().enumerate();
-    match lines.next() {
-        Some((_, h)) if h.trim() == HEADER => {}
-        Some((_, h)) => return Err(err(1, format!("header `{}` is not the expected `{HEADER}`", h.trim()))),
-        None => return Err(err(1, "empty file, expected a header".into())),
-    }
-    lines
-        .filter(|(_, l)| !l.trim().is_empty())
-        .map(|(i, l)| TrialRow::from_csv(l).map(|r| (i + 1, r)).map_err(|m| err(i + 1, m)))
-        .collect()
+    Ok(parse_rows(text, path)?.into_iter().map(|(_, r)| r).collect())
 }
 
 /// Joins the `results.csv` of several shard folders, refusing a (trial, algorithm) found twice.
@@ -179,7 +157,7 @@ pub fn collect(dirs: &[PathBuf]) -> Result<Vec<TrialRow>, StudyError> {
     let mut all = Vec::new();
     for d in dirs {
         let path = d.join("results.csv");
-        for (line, r) in read_numbered(&path)? {
+        for (line, r) in read_rows::<TrialRow>(&path)? {
             if let Some((first, first_line)) = seen.insert((r.trial, r.algorithm.clone()), (path.clone(), line)) {
                 return Err(StudyError::Results {
                     path,

@@ -1,21 +1,22 @@
 //! `mrslam study`: many seeded merge trials across overlaps — map level (`overlap`), simulation level
-//! (`scenario`), real data (`logs`: a real log split in time into robots), and joining the shards of a study
-//! split across machines (`collect`). One module per subcommand; the progress, resume and output helpers they
-//! share here.
+//! (`scenario`), real data (`logs`: a real log split in time into robots) — team exploration over numbers of
+//! robots, ranges, coordinations and mergers (`team`), and joining the shards of a study split across machines
+//! (`collect`). One module per subcommand; the progress, resume and output helpers they share here.
 
 mod collect;
 mod logs;
 mod overlap;
 mod scenario;
+mod team;
 
 use crate::cmd::{Outputs, kind};
 use anyhow::{Context, Result, bail};
 use clap::Subcommand;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use mrslam_studies::journal::{Journal, StudyParams};
-use mrslam_studies::results::{TrialRow, sort_rows};
+use mrslam_studies::results::TrialRow;
 use mrslam_studies::summary::table;
-use mrslam_studies::{self as study, Progress, Shard, StudyError};
+use mrslam_studies::{self as study, CsvRow, Progress, Shard, StudyError};
 use std::collections::BTreeSet;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -34,6 +35,9 @@ pub enum StudyCommand {
     /// Real-data study: split a CARMEN log in time into N robots, map each with the SLAM, merge every pair
     /// the relations connect with each algorithm, score against the relations.
     Logs(logs::LogsArgs),
+    /// Team study: run a team scenario with the first N robots, each range, coordination and online merger, and
+    /// each seed; coverage over time, time to 90 %, redundancy and online merges per configuration.
+    Team(team::TeamArgs),
 }
 
 /// Runs `mrslam study`.
@@ -43,6 +47,7 @@ pub fn run(cmd: StudyCommand) -> Result<ExitCode> {
         StudyCommand::Scenario(a) => scenario::run(a),
         StudyCommand::Collect(a) => collect::run(a),
         StudyCommand::Logs(a) => logs::run(a),
+        StudyCommand::Team(a) => team::run(a),
     }
 }
 
@@ -96,20 +101,21 @@ pub(super) fn create_out(dir: &Path) -> Result<()> {
 
 /// A running study's progress: the trials done before a resume are skipped; each finished trial's rows are
 /// appended to results.csv at once, so an interruption loses no finished trial.
-pub(super) struct Recorder {
-    journal: Journal,
+pub(super) struct Recorder<R> {
+    journal: Journal<R>,
     done: BTreeSet<usize>,
     bar: ProgressBar,
 }
 
-impl Progress for Recorder {
+impl<R: CsvRow> Progress<R> for Recorder<R> {
     fn skip(&self, trial: usize) -> bool {
         self.done.contains(&trial)
     }
 
-    fn finished(&self, rows: &[TrialRow]) -> Result<(), StudyError> {
+    fn finished(&self, rows: &[R]) -> Result<(), StudyError> {
         self.journal.append(rows)?;
-        self.bar.inc(1);
+        let trials: BTreeSet<usize> = rows.iter().map(CsvRow::trial).collect();
+        self.bar.inc(trials.len() as u64);
         Ok(())
     }
 }
@@ -131,18 +137,20 @@ pub(super) fn study_outputs<'p>(out: &Path, inputs: impl IntoIterator<Item = &'p
     rule
 }
 
-/// Creates the study folder `out` (its outputs checked against `inputs` first) and opens its journal.
-pub(super) fn open_study<'p>(
+/// Creates the study folder `out` (its outputs, the usual four and `more`, checked against `inputs` first) and
+/// opens its journal.
+pub(super) fn open_study<'p, R: CsvRow>(
     out: &Path,
     inputs: impl IntoIterator<Item = &'p Path>,
+    more: &[PathBuf],
     params: &StudyParams,
     rows_per_trial: usize,
     resume: bool,
-) -> Result<(Journal, Vec<TrialRow>)> {
+) -> Result<(Journal<R>, Vec<R>)> {
     if out.is_file() {
         bail!("--out {}: is a file, expected a folder", out.display());
     }
-    let rule = study_outputs(out, inputs, &[]);
+    let rule = study_outputs(out, inputs, more);
     if out.is_dir() {
         rule.check()?;
     }
@@ -150,23 +158,22 @@ pub(super) fn open_study<'p>(
     rule.check()?;
     let (journal, earlier) = Journal::open(out, params, rows_per_trial, resume)?;
     if resume {
-        let trials: BTreeSet<usize> = earlier.iter().map(|r| r.trial).collect();
+        let trials: BTreeSet<usize> = earlier.iter().map(CsvRow::trial).collect();
         println!("resuming {}: {} trials already done", out.display(), trials.len());
     }
     Ok((journal, earlier))
 }
 
-/// Runs the trials not yet done, then joins the rows with those of before the resume.
-pub(super) fn run_study(
-    earlier: Vec<TrialRow>,
-    journal: Journal,
+/// Runs the trials not yet done, then joins the rows with those of before the resume (the caller sorts them).
+pub(super) fn run_study<R: CsvRow>(
+    earlier: Vec<R>,
+    journal: Journal<R>,
     selected: &[usize],
-    algorithms: &[String],
     quiet: bool,
     what: &str,
-    run: impl FnOnce(&Recorder) -> Result<Vec<TrialRow>, StudyError>,
-) -> Result<(Vec<TrialRow>, usize, f64)> {
-    let done: BTreeSet<usize> = earlier.iter().map(|r| r.trial).collect();
+    run: impl FnOnce(&Recorder<R>) -> Result<Vec<R>, StudyError>,
+) -> Result<(Vec<R>, usize, f64)> {
+    let done: BTreeSet<usize> = earlier.iter().map(CsvRow::trial).collect();
     let n = selected.iter().filter(|t| !done.contains(t)).count();
     let recorder = Recorder { journal, done, bar: progress_bar(n, quiet, what) };
     let start = Instant::now();
@@ -175,7 +182,6 @@ pub(super) fn run_study(
     recorder.bar.finish_and_clear();
     let mut rows = earlier;
     rows.extend(new);
-    sort_rows(&mut rows, algorithms);
     Ok((rows, n, seconds))
 }
 

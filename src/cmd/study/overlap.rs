@@ -9,6 +9,7 @@ use mrslam_merge::Encoding;
 use mrslam_merge::floorplan::FloorplanParams;
 use mrslam_studies::journal::{StudyParams, fingerprint};
 use mrslam_studies::overlap::{MapSource, MapStyle, OverlapStudy, run_overlap_study};
+use mrslam_studies::results::sort_rows;
 use mrslam_studies::{self as study, parse_range};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -137,11 +138,11 @@ pub(super) fn run(a: OverlapArgs) -> Result<ExitCode> {
         .set("map_style", &a.map_style)
         .set("encoding", a.encoding);
     let inputs = a.map.iter().chain(&a.world).map(PathBuf::as_path);
-    let (journal, earlier) = open_study(&a.out, inputs, &params, algorithms.len(), a.resume)?;
+    let (journal, earlier) = open_study(&a.out, inputs, &[], &params, algorithms.len(), a.resume)?;
     let selected: Vec<usize> = study.selected_trials().iter().map(|t| t.trial).collect();
-    let (rows, n, seconds) = run_study(earlier, journal, &selected, &algorithms, a.quiet, "overlap study", |p| {
-        run_overlap_study(&study, p)
-    })?;
+    let (mut rows, n, seconds) =
+        run_study(earlier, journal, &selected, a.quiet, "overlap study", |p| run_overlap_study(&study, p))?;
+    sort_rows(&mut rows, &algorithms);
     finish(&rows, &a.out, n, Some(seconds))
 }
 

@@ -4,6 +4,7 @@ use super::{finish, open_study, run_study, shard_of};
 use anyhow::{Context, Result};
 use clap::Args;
 use mrslam_studies::journal::{StudyParams, fingerprint};
+use mrslam_studies::results::sort_rows;
 use mrslam_studies::{Sweep, run_sweep};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -68,10 +69,10 @@ pub(super) fn run(a: ScenarioArgs) -> Result<ExitCode> {
     params.set("algorithms", algorithms.join(","));
     params.set("seeds", sweep.seeds.iter().map(u64::to_string).collect::<Vec<_>>().join(","));
     let inputs = [sweep.path.as_path(), sweep.scenario.path.as_path(), sweep.scenario.world_path.as_path()];
-    let (journal, earlier) = open_study(&a.out, inputs, &params, algorithms.len(), a.resume)?;
+    let (journal, earlier) = open_study(&a.out, inputs, &[], &params, algorithms.len(), a.resume)?;
     let selected: Vec<usize> = (0..sweep.trials()).filter(|t| shard.selects(*t)).collect();
-    let (rows, n, seconds) = run_study(earlier, journal, &selected, &algorithms, a.quiet, &sweep.scenario.name, |p| {
-        run_sweep(&sweep, shard, p)
-    })?;
+    let (mut rows, n, seconds) =
+        run_study(earlier, journal, &selected, a.quiet, &sweep.scenario.name, |p| run_sweep(&sweep, shard, p))?;
+    sort_rows(&mut rows, &algorithms);
     finish(&rows, &a.out, n, Some(seconds))
 }
