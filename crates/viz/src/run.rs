@@ -7,7 +7,7 @@
 //! shows drift as the gap between the true path and the others.
 
 use crate::VizError;
-use crate::blueprint::{Layout, ViewKind};
+use crate::blueprint::{Layout, ViewKind, query};
 use crate::convert::{Rgba, lighten, robot_color, with_alpha};
 use crate::maps::{MATCH_BAD, MATCH_GOOD, MATCH_GOOD_M};
 use crate::metrics::Level;
@@ -363,10 +363,6 @@ pub(crate) fn record_merge(rec: &mut Recorder, m: &MergeView<'_>, a: (&Pose2, Rg
     rec.log_event(if m.accepted { Level::Info } else { Level::Warn }, &text);
 }
 
-fn q(prefix: char, p: &EntityPath, deep: bool) -> String {
-    if deep { format!("{prefix} {p}/**") } else { format!("{prefix} {p}") }
-}
-
 /// The layout of a run: the world on top, each robot's map in its own frame, then the merges, the metrics
 /// and the events.
 pub fn run_layout(robots: &[String], algorithms: &[String]) -> Layout {
@@ -375,13 +371,13 @@ pub fn run_layout(robots: &[String], algorithms: &[String]) -> Layout {
         ViewKind::Spatial2D,
         "world (truth, odometry, SLAM, scans)",
         root.clone(),
-        &[q('+', &paths::root("world"), true), q('+', &paths::root("robots"), true)],
+        &[query('+', &paths::root("world"), true), query('+', &paths::root("robots"), true)],
     );
     let maps = robots
         .iter()
         .map(|r| {
-            let mut contents = vec![q('+', &paths::map(r), false), q('+', &paths::robot(r, &["slam"]), true)];
-            contents.extend(algorithms.iter().map(|a| q('+', &paths::merge(a, &["keypoints", r]), false)));
+            let mut contents = vec![query('+', &paths::map(r), false), query('+', &paths::robot(r, &["slam"]), true)];
+            contents.extend(algorithms.iter().map(|a| query('+', &paths::merge(a, &["keypoints", r]), false)));
             Layout::view(ViewKind::Spatial2D, &format!("{r}: SLAM map"), paths::map(r), &contents)
         })
         .collect();
@@ -389,16 +385,16 @@ pub fn run_layout(robots: &[String], algorithms: &[String]) -> Layout {
         .iter()
         .map(|a| {
             let contents = [
-                q('+', &paths::walls(), false),
-                q('+', &paths::root("maps"), true),
-                q('+', &paths::merge(a, &[]), true),
+                query('+', &paths::walls(), false),
+                query('+', &paths::root("maps"), true),
+                query('+', &paths::merge(a, &[]), true),
             ];
             Layout::view(ViewKind::Spatial2D, &format!("merge: {a}"), root.clone(), &contents)
         })
         .collect();
     let series = |group: &str, title: &str| {
         let origin = paths::metric(group, &[]);
-        Layout::view(ViewKind::TimeSeries, title, origin.clone(), &[q('+', &origin, true)])
+        Layout::view(ViewKind::TimeSeries, title, origin.clone(), &[query('+', &origin, true)])
     };
     let metrics = Layout::Vertical(
         vec![
@@ -408,7 +404,7 @@ pub fn run_layout(robots: &[String], algorithms: &[String]) -> Layout {
         ],
         vec![],
     );
-    let events = Layout::view(ViewKind::TextLog, "events", paths::events(), &[q('+', &paths::events(), false)]);
+    let events = Layout::view(ViewKind::TextLog, "events", paths::events(), &[query('+', &paths::events(), false)]);
     let bottom = Layout::Horizontal(vec![Layout::Tabs(merges), metrics, events], vec![2.0, 1.5, 1.5]);
     Layout::Vertical(vec![world, Layout::Horizontal(maps, vec![]), bottom], vec![3.0, 2.0, 3.0])
 }
