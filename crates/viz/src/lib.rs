@@ -8,9 +8,9 @@
 //! [`inspect::summarize`] reads a recording back with rerun's own decoder.
 //!
 //! Entity paths (ARCHITECTURE.md, "Recordings"): `world/{walls,truth_map}`,
-//! `robots/<name>/{truth,truth/path,odom,odom/path,slam/pose,slam/path,slam/particles,scan}`, `maps/<name>`,
-//! `merge/<algorithm>/{keypoints/<name>,matches,merged}`, `metrics/{error,neff,slip}/...`, `events`; a SLAM run
-//! on a log adds `robots/<name>/{odom/pose,relations}` and `metrics/{realtime,relations}/...`; timelines
+//! `robots/<name>/{truth,truth/path,odom,odom/path,slam/pose,slam/path,slam/particles,slam/goal,slam/goal/path,scan}`,
+//! `maps/<name>`, `merge/<algorithm>/{keypoints/<name>,matches,merged}`, `metrics/{error,neff,slip}/...`, `events`;
+//! a SLAM run on a log adds `robots/<name>/{odom/pose,relations}` and `metrics/{realtime,relations}/...`; timelines
 //! `sim_time` (seconds) and `step`. Nothing here runs unless a recording was asked for.
 //!
 //! ```

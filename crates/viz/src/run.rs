@@ -15,7 +15,7 @@ use crate::paths;
 use crate::recorder::{Recorder, RecordingStats};
 use mrslam_core::{LaserScan, OccupancyGrid, Pose2};
 use nalgebra::Point2;
-use rerun::EntityPath;
+use rerun::{Clear, EntityPath};
 
 /// How often the expensive things are logged, in simulated seconds (for a log, seconds of log time).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -114,6 +114,8 @@ struct Track {
     steps: u32,
     slip_steps: u32,
     contact: bool,
+    /// The path to the exploration goal last drawn (empty: none), and whether a team planner assigned it.
+    goal: (Vec<Point2<f64>>, bool),
 }
 
 /// Records a testbed run: see the module docs.
@@ -175,6 +177,7 @@ impl RunRecorder {
                 steps: 0,
                 slip_steps: 0,
                 contact: false,
+                goal: (Vec::new(), false),
             })
             .collect();
         for t in &self.tracks {
@@ -304,6 +307,26 @@ impl RunRecorder {
         t.map_dirty = false;
         let (name, c) = (t.name.clone(), t.color);
         self.rec.log_map(&paths::map(&name), grid, &frame, c);
+    }
+
+    /// Robot `i`'s exploration goal now: the path to it (its SLAM map frame; the goal is the last point, none when
+    /// empty), and whether its team's planner `assigned` it (else the robot chose it on its own map). Logs
+    /// `robots/<name>/slam/goal` and `.../goal/path` only when they changed; clears them when the goal is gone.
+    pub fn goal(&mut self, i: usize, path: &[Point2<f64>], assigned: bool) {
+        let Some(t) = self.tracks.get_mut(i) else { return };
+        if t.goal.0 == path && t.goal.1 == assigned {
+            return;
+        }
+        t.goal = (path.to_vec(), assigned);
+        let (name, c) = (t.name.clone(), t.color);
+        let entity = paths::robot(&name, &["slam", "goal"]);
+        let Some(goal) = path.last() else {
+            self.rec.log(&entity, &Clear::recursive());
+            return;
+        };
+        let label = if assigned { format!("{name}: team goal") } else { format!("{name}: goal") };
+        self.rec.log_goal(&entity, goal, c, &label);
+        self.rec.log_plan(&paths::robot(&name, &["slam", "goal", "path"]), path, with_alpha(c, 170));
     }
 
     /// Logs an event.

@@ -2,6 +2,7 @@
 
 use super::agent::{Agent, Reading};
 use super::options::RunError;
+use crate::controller::Controller;
 use mrslam_core::{OccupancyGrid, Pose2};
 use mrslam_merge::{Algorithm, MergeOutcome};
 use mrslam_sim::{Obstacle, Sim, StepEvents};
@@ -65,7 +66,8 @@ pub(super) fn viz_begin(
     v.begin(&viz_walls(sim), truth, &robots, &algorithms);
 }
 
-/// A step: slip and contacts, and this step's scans with the true and odometry poses they were taken at.
+/// A step: slip and contacts, this step's scans with the true and odometry poses they were taken at, and each
+/// explorer's goal (drawn only when it changed).
 pub(super) fn viz_step(
     v: &mut RunRecorder,
     step: u64,
@@ -79,6 +81,9 @@ pub(super) fn viz_step(
         v.robot_step(k, ev.slipping, ev.contact);
         for (scan, odom, pose) in batch {
             v.scan(k, pose, &odom.pose, scan, &a.setup.lidar.mount);
+        }
+        if let Controller::Explore(e) = &a.controller {
+            v.goal(k, e.path(), a.coordinated);
         }
     }
 }
