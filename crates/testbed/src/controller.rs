@@ -84,6 +84,11 @@ impl PurePursuit {
         self.path.last().copied()
     }
 
+    /// The whole path it was given, driven or not.
+    pub fn path(&self) -> &[Point2<f64>] {
+        &self.path
+    }
+
     /// The carrot: the point one look-ahead ahead along the path.
     fn carrot(&mut self, p: &Point2<f64>) -> Point2<f64> {
         // Advance past waypoints already within the look-ahead circle.
@@ -240,6 +245,11 @@ impl Explorer {
     /// The goal it drives to (the last point of its path), if it has one.
     pub fn goal(&self) -> Option<Point2<f64>> {
         self.follower.as_ref().and_then(PurePursuit::goal)
+    }
+
+    /// The path to its goal (ending at the goal), empty when it has none.
+    pub fn path(&self) -> &[Point2<f64>] {
+        self.follower.as_ref().map_or(&[], PurePursuit::path)
     }
 
     /// Forward speed and turn rate for the robot at `pose` (SLAM frame); `blocked` when something is in the

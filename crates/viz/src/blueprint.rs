@@ -77,6 +77,11 @@ impl Layout {
     }
 }
 
+/// A query expression: `prefix` (`+` or `-`) and `p`, with all its descendants when `deep`.
+pub fn query(prefix: char, p: &EntityPath, deep: bool) -> String {
+    if deep { format!("{prefix} {p}/**") } else { format!("{prefix} {p}") }
+}
+
 type Row = (rerun::log::RowId, TimePoint, Vec<rerun::SerializedComponentBatch>);
 
 /// Builds the blueprint store's rows for a layout.

@@ -32,11 +32,16 @@ impl Recorder {
 
     /// Logs an event as a line of text at `events`, at the current time.
     pub fn log_event(&mut self, level: Level, text: &str) {
+        self.log_text(&paths::events(), level, text);
+    }
+
+    /// Logs a line of text at `entity` (a text log of its own, e.g. `team/events`), at the current time.
+    pub fn log_text(&mut self, entity: &EntityPath, level: Level, text: &str) {
         let level = match level {
             Level::Info => TextLogLevel::INFO,
             Level::Warn => TextLogLevel::WARN,
             Level::Error => TextLogLevel::ERROR,
         };
-        self.log(&paths::events(), &TextLog::new(text).with_level(level));
+        self.log(entity, &TextLog::new(text).with_level(level));
     }
 }

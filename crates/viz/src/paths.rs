@@ -5,7 +5,7 @@ use rerun::EntityPath;
 use rerun::external::re_log_types::EntityPathPart;
 
 /// Roots drawn in the world's frame; each carries the display flip (see the private `world` module).
-pub const SPATIAL_ROOTS: [&str; 4] = ["world", "robots", "maps", "merge"];
+pub const SPATIAL_ROOTS: [&str; 5] = ["world", "robots", "maps", "merge", "team"];
 
 fn path(parts: &[&str]) -> EntityPath {
     EntityPath::new(parts.iter().map(|p| EntityPathPart::new(*p)).collect())
@@ -52,6 +52,19 @@ pub fn metric(group: &str, series: &[&str]) -> EntityPath {
     path(&parts)
 }
 
+/// `team/<leaf...>`: the team part of a run, e.g. `team/attempts` (the merge attempts as lines between the robots),
+/// `team/events` (the attempts as text).
+pub fn team(leaf: &[&str]) -> EntityPath {
+    let mut parts = vec!["team"];
+    parts.extend_from_slice(leaf);
+    path(&parts)
+}
+
+/// `team/maps/<root>`: the map of the team whose root (the frame of its map) is robot `root`.
+pub fn team_map(root: &str) -> EntityPath {
+    path(&["team", "maps", root])
+}
+
 /// `events`: what happened, as text (resampling, collisions, merges accepted or rejected and why).
 pub fn events() -> EntityPath {
     path(&["events"])
@@ -66,6 +79,8 @@ mod tests {
         assert_eq!(walls().to_string(), "/world/walls");
         assert_eq!(robot("experia", &["slam", "particles"]).to_string(), "/robots/experia/slam/particles");
         assert_eq!(merge("sift", &["keypoints", "prawn"]).to_string(), "/merge/sift/keypoints/prawn");
+        assert_eq!(team_map("experia").to_string(), "/team/maps/experia");
+        assert_eq!(team(&["attempts"]).to_string(), "/team/attempts");
         // A name with a slash stays one part.
         assert_eq!(map("a/b").len(), 2);
     }

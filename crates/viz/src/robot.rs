@@ -43,6 +43,27 @@ impl Recorder {
         self.log(entity, &arch);
     }
 
+    /// Logs a goal as a large dot with a label (none when empty), at the current time.
+    pub fn log_goal(&mut self, entity: &EntityPath, goal: &Point2<f64>, c: Rgba, label: &str) {
+        let mut arch = Points2D::new([xy(goal)])
+            .with_colors([color(c)])
+            .with_radii([Radius::new_ui_points(6.0)])
+            .with_draw_order(DrawOrder::from(layer::POSES));
+        if !label.is_empty() {
+            arch = arch.with_labels([label]);
+        }
+        self.log(entity, &arch);
+    }
+
+    /// Logs a planned path (points in the parent's frame) as one thin line strip, at the current time.
+    pub fn log_plan(&mut self, entity: &EntityPath, points: &[Point2<f64>], c: Rgba) {
+        let arch = LineStrips2D::new([LineStrip2D::from_iter(points.iter().map(xy))])
+            .with_colors([color(c)])
+            .with_radii([Radius::new_ui_points(1.5)])
+            .with_draw_order(DrawOrder::from(layer::PATHS));
+        self.log(entity, &arch);
+    }
+
     /// Logs scan end points (already in the parent's frame) as small dots, at the current time.
     pub fn log_scan_points(&mut self, entity: &EntityPath, points: &[Point2<f64>], c: Rgba) {
         let arch = Points2D::new(points.iter().map(xy))

@@ -7,15 +7,16 @@
 //! shows drift as the gap between the true path and the others.
 
 use crate::VizError;
-use crate::blueprint::{Layout, ViewKind};
+use crate::blueprint::{Layout, ViewKind, query};
 use crate::convert::{Rgba, lighten, robot_color, with_alpha};
 use crate::maps::{MATCH_BAD, MATCH_GOOD, MATCH_GOOD_M};
 use crate::metrics::Level;
 use crate::paths;
 use crate::recorder::{Recorder, RecordingStats};
+use crate::team::{AttemptView, TeamTrack, team_views};
 use mrslam_core::{LaserScan, OccupancyGrid, Pose2};
 use nalgebra::Point2;
-use rerun::EntityPath;
+use rerun::{Clear, EntityPath};
 
 /// How often the expensive things are logged, in simulated seconds (for a log, seconds of log time).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -114,6 +115,8 @@ struct Track {
     steps: u32,
     slip_steps: u32,
     contact: bool,
+    /// The path to the exploration goal last drawn (empty: none), and whether a team planner assigned it.
+    goal: (Vec<Point2<f64>>, bool),
 }
 
 /// Records a testbed run: see the module docs.
@@ -123,12 +126,14 @@ pub struct RunRecorder {
     rates: Rates,
     tracks: Vec<Track>,
     step: u64,
+    /// The team part, for a run with teams.
+    team: Option<TeamTrack>,
 }
 
 impl RunRecorder {
     /// Wraps an open recording.
     pub fn new(rec: Recorder) -> Self {
-        RunRecorder { rec, rates: Rates::default(), tracks: Vec::new(), step: 0 }
+        RunRecorder { rec, rates: Rates::default(), tracks: Vec::new(), step: 0, team: None }
     }
 
     /// Changes the rates.
@@ -143,13 +148,15 @@ impl RunRecorder {
     }
 
     /// Logs what is static (the world's walls and true map, each robot's odometry frame and colours) and the
-    /// layout for `robots` and merge `algorithms`.
+    /// layout for `robots` and merge `algorithms`; with `team`, the run's robots form teams as they meet (team
+    /// maps, merge attempts, coverage: see [`Self::team_map`], [`Self::attempt`], [`Self::coverage`]).
     pub fn begin(
         &mut self,
         walls: &[Vec<Point2<f64>>],
         truth: &OccupancyGrid,
         robots: &[RobotInfo],
         algorithms: &[String],
+        team: bool,
     ) {
         self.rec.log_display_frame();
         self.rec.log_walls(walls);
@@ -175,6 +182,7 @@ impl RunRecorder {
                 steps: 0,
                 slip_steps: 0,
                 contact: false,
+                goal: (Vec::new(), false),
             })
             .collect();
         for t in &self.tracks {
@@ -186,8 +194,13 @@ impl RunRecorder {
             self.rec.log_series_style(&paths::metric("neff", &[n]), &format!("{n} Neff"), t.color);
             self.rec.log_series_style(&paths::metric("slip", &[n]), &format!("{n} slipping"), t.color);
         }
+        if team {
+            let mut track = TeamTrack::default();
+            track.begin(&mut self.rec);
+            self.team = Some(track);
+        }
         let names: Vec<String> = robots.iter().map(|r| r.name.clone()).collect();
-        self.rec.send_layout(&run_layout(&names, algorithms));
+        self.rec.send_layout(&run_layout(&names, algorithms, team));
         self.rec.log_event(Level::Info, &format!("run started: {}", names.join(", ")));
     }
 
@@ -195,6 +208,9 @@ impl RunRecorder {
     pub fn set_time(&mut self, step: u64, sim_time: f64) {
         self.step = step;
         self.rec.set_time(step, sim_time);
+        if let Some(t) = self.team.as_mut() {
+            t.tick(&mut self.rec);
+        }
     }
 
     /// One simulation step of robot `i`: whether its wheels slipped and whether it touches an obstacle.
@@ -306,6 +322,52 @@ impl RunRecorder {
         self.rec.log_map(&paths::map(&name), grid, &frame, c);
     }
 
+    /// Robot `i`'s exploration goal now: the path to it (its SLAM map frame; the goal is the last point, none when
+    /// empty), and whether its team's planner `assigned` it (else the robot chose it on its own map). Logs
+    /// `robots/<name>/slam/goal` and `.../goal/path` only when they changed; clears them when the goal is gone.
+    pub fn goal(&mut self, i: usize, path: &[Point2<f64>], assigned: bool) {
+        let Some(t) = self.tracks.get_mut(i) else { return };
+        if t.goal.0 == path && t.goal.1 == assigned {
+            return;
+        }
+        t.goal = (path.to_vec(), assigned);
+        let (name, c) = (t.name.clone(), t.color);
+        let entity = paths::robot(&name, &["slam", "goal"]);
+        let Some(goal) = path.last() else {
+            self.rec.log(&entity, &Clear::recursive());
+            return;
+        };
+        let label = if assigned { format!("{name}: team goal") } else { format!("{name}: goal") };
+        self.rec.log_goal(&entity, goal, c, &label);
+        self.rec.log_plan(&paths::robot(&name, &["slam", "goal", "path"]), path, with_alpha(c, 170));
+    }
+
+    /// Logs the map of the team whose root is robot `i` (the root's SLAM map frame, placed where the root truly
+    /// was at its first processed scan) at `team/maps/<name>`; call it when the team's map changed. Nothing for a
+    /// run without teams.
+    pub fn team_map(&mut self, i: usize, grid: &OccupancyGrid) {
+        let (Some(team), Some(t)) = (self.team.as_mut(), self.tracks.get(i)) else { return };
+        let Some(frame) = t.frame else { return };
+        team.map(&mut self.rec, &t.name, grid, &frame, t.color);
+    }
+
+    /// Logs a merge attempt between two teams at `team/attempts` (a line between the robots), `team/events` (what
+    /// and why) and `metrics/merges/...` (the counts). Nothing for a run without teams.
+    pub fn attempt(&mut self, a: &AttemptView<'_>) {
+        if let Some(team) = self.team.as_mut() {
+            team.attempt(&mut self.rec, a);
+        }
+    }
+
+    /// Logs a coverage sample at `metrics/coverage/{mapped,redundancy}`: the share of the reachable free area some
+    /// robot's map marks free, and of the area the robots' beams crossed the share more than one crossed. Nothing
+    /// for a run without teams.
+    pub fn coverage(&mut self, mapped: f64, redundancy: f64) {
+        if let Some(team) = self.team.as_mut() {
+            team.coverage(&mut self.rec, mapped, redundancy);
+        }
+    }
+
     /// Logs an event.
     pub fn event(&mut self, level: Level, text: &str) {
         self.rec.log_event(level, text);
@@ -363,25 +425,21 @@ pub(crate) fn record_merge(rec: &mut Recorder, m: &MergeView<'_>, a: (&Pose2, Rg
     rec.log_event(if m.accepted { Level::Info } else { Level::Warn }, &text);
 }
 
-fn q(prefix: char, p: &EntityPath, deep: bool) -> String {
-    if deep { format!("{prefix} {p}/**") } else { format!("{prefix} {p}") }
-}
-
-/// The layout of a run: the world on top, each robot's map in its own frame, then the merges, the metrics
-/// and the events.
-pub fn run_layout(robots: &[String], algorithms: &[String]) -> Layout {
+/// The layout of a run: the world on top (with `team`, the teams' view beside it), each robot's map in its own
+/// frame, then the merges, the metrics (with `team`, coverage and merge counts) and the events.
+pub fn run_layout(robots: &[String], algorithms: &[String], team: bool) -> Layout {
     let root = EntityPath::root();
     let world = Layout::view(
         ViewKind::Spatial2D,
         "world (truth, odometry, SLAM, scans)",
         root.clone(),
-        &[q('+', &paths::root("world"), true), q('+', &paths::root("robots"), true)],
+        &[query('+', &paths::root("world"), true), query('+', &paths::root("robots"), true)],
     );
     let maps = robots
         .iter()
         .map(|r| {
-            let mut contents = vec![q('+', &paths::map(r), false), q('+', &paths::robot(r, &["slam"]), true)];
-            contents.extend(algorithms.iter().map(|a| q('+', &paths::merge(a, &["keypoints", r]), false)));
+            let mut contents = vec![query('+', &paths::map(r), false), query('+', &paths::robot(r, &["slam"]), true)];
+            contents.extend(algorithms.iter().map(|a| query('+', &paths::merge(a, &["keypoints", r]), false)));
             Layout::view(ViewKind::Spatial2D, &format!("{r}: SLAM map"), paths::map(r), &contents)
         })
         .collect();
@@ -389,28 +447,35 @@ pub fn run_layout(robots: &[String], algorithms: &[String]) -> Layout {
         .iter()
         .map(|a| {
             let contents = [
-                q('+', &paths::walls(), false),
-                q('+', &paths::root("maps"), true),
-                q('+', &paths::merge(a, &[]), true),
+                query('+', &paths::walls(), false),
+                query('+', &paths::root("maps"), true),
+                query('+', &paths::merge(a, &[]), true),
             ];
             Layout::view(ViewKind::Spatial2D, &format!("merge: {a}"), root.clone(), &contents)
         })
         .collect();
     let series = |group: &str, title: &str| {
         let origin = paths::metric(group, &[]);
-        Layout::view(ViewKind::TimeSeries, title, origin.clone(), &[q('+', &origin, true)])
+        Layout::view(ViewKind::TimeSeries, title, origin.clone(), &[query('+', &origin, true)])
     };
-    let metrics = Layout::Vertical(
-        vec![
-            series("error", "trajectory error (m)"),
-            series("neff", "Neff"),
-            series("slip", "slipping (share of steps)"),
-        ],
-        vec![],
-    );
-    let events = Layout::view(ViewKind::TextLog, "events", paths::events(), &[q('+', &paths::events(), false)]);
-    let bottom = Layout::Horizontal(vec![Layout::Tabs(merges), metrics, events], vec![2.0, 1.5, 1.5]);
-    Layout::Vertical(vec![world, Layout::Horizontal(maps, vec![]), bottom], vec![3.0, 2.0, 3.0])
+    let mut metrics = vec![
+        series("error", "trajectory error (m)"),
+        series("neff", "Neff"),
+        series("slip", "slipping (share of steps)"),
+    ];
+    let mut events = vec![query('+', &paths::events(), false)];
+    let top = if team {
+        let (view, series) = team_views(robots);
+        metrics.splice(0..0, series);
+        events.push(query('+', &paths::team(&["events"]), false));
+        Layout::Horizontal(vec![world, view], vec![])
+    } else {
+        world
+    };
+    let events = Layout::view(ViewKind::TextLog, "events", paths::events(), &events);
+    let bottom =
+        Layout::Horizontal(vec![Layout::Tabs(merges), Layout::Vertical(metrics, vec![]), events], vec![2.0, 1.5, 1.5]);
+    Layout::Vertical(vec![top, Layout::Horizontal(maps, vec![]), bottom], vec![3.0, 2.0, 3.0])
 }
 
 #[cfg(test)]
@@ -419,11 +484,81 @@ mod tests {
 
     #[test]
     fn layout_names_every_view() {
-        let l = run_layout(&["experia".into(), "prawn".into()], &["sift".into(), "rmap".into()]);
+        let robots = ["experia".to_string(), "prawn".to_string()];
+        let l = run_layout(&robots, &["sift".into(), "rmap".into()], false);
         let names = l.view_names();
         assert!(names.iter().any(|n| n.starts_with("world")));
         assert!(names.contains(&"experia: SLAM map".to_string()));
         assert!(names.contains(&"merge: rmap".to_string()));
         assert!(names.contains(&"events".to_string()));
+        assert!(!names.iter().any(|n| n.starts_with("team") || n.starts_with("coverage")), "{names:?}");
+        let team = run_layout(&robots, &["cascade".into()], true).view_names();
+        for view in ["team (team maps, merge attempts, goals)", "coverage (share)", "online merges (count)"] {
+            assert!(team.contains(&view.to_string()), "{view}: {team:?}");
+        }
+    }
+
+    #[test]
+    fn a_team_run_records_goals_attempts_team_maps_and_coverage_when_they_change() {
+        use crate::team::AttemptOutcome;
+        use mrslam_core::pose;
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("team.rrd");
+        let rec = Recorder::open(&[crate::Target::File(path.clone())], "team", "team").unwrap();
+        let mut v = RunRecorder::new(rec);
+        let robots = [
+            RobotInfo { name: "a".into(), start: pose(0.0, 0.0, 0.0) },
+            RobotInfo { name: "b".into(), start: pose(5.0, 0.0, 0.0) },
+        ];
+        let grid = OccupancyGrid::new(10, 10, 0.1, Pose2::identity()).unwrap();
+        v.begin(&[], &grid, &robots, &[], true);
+        for (i, r) in robots.iter().enumerate() {
+            let state = SlamState {
+                scans: 1,
+                best: &r.start,
+                hypotheses: &[],
+                effective: None,
+                resamples: 0,
+                frame: Some(r.start),
+            };
+            v.slam(i, state);
+        }
+        let p = |x: f64| Point2::new(x, 0.0);
+        v.set_time(1, 0.1);
+        v.goal(0, &[p(1.0), p(2.0)], false);
+        v.goal(0, &[p(1.0), p(2.0)], false); // unchanged: nothing logged
+        v.set_time(2, 0.2);
+        v.goal(0, &[p(1.0), p(2.0)], true); // now the team's: logged again
+        v.goal(0, &[], true); // gone: cleared
+        let (ta, tb) = (["a".to_string()], ["b".to_string()]);
+        let refused = AttemptView {
+            robots: ["a", "b"],
+            at: [p(0.0), p(5.0)],
+            teams: [&ta, &tb],
+            outcome: AttemptOutcome::Refused,
+            stage: None,
+            reason: Some("too few inliers"),
+            error: None,
+        };
+        v.attempt(&refused);
+        v.set_time(3, 0.2 + crate::team::ATTEMPT_SHOW_S); // the line is cleared
+        v.attempt(&AttemptView { outcome: AttemptOutcome::Correct, reason: None, error: Some((0.5, 0.02)), ..refused });
+        v.team_map(0, &grid);
+        v.coverage(0.5, 0.1);
+        v.finish().unwrap();
+
+        let s = crate::inspect::summarize(&path).unwrap();
+        let at = |e: &str| s.rows_at(e) - s.static_rows.get(e).copied().unwrap_or(0);
+        assert_eq!(at("/robots/a/slam/goal"), 3, "{:?}", s.rows);
+        assert_eq!(at("/robots/a/slam/goal/path"), 2);
+        assert_eq!(at("/robots/b/slam/goal"), 0);
+        assert_eq!(at("/team/events"), 2);
+        assert_eq!(at("/team/attempts"), 3, "a line, its clearing, a line");
+        assert_eq!(at("/team/maps/a"), 1);
+        assert_eq!((at("/metrics/coverage/mapped"), at("/metrics/coverage/redundancy")), (1, 1));
+        // A zero at the start, one value per attempt (two when it changed: a step), one per coverage sample.
+        assert_eq!(at("/metrics/merges/accepted"), 1 + 1 + 2 + 1);
+        assert_eq!(at("/metrics/merges/refused"), 1 + 2 + 1 + 1);
+        assert_eq!(at("/metrics/merges/false"), 1 + 1 + 1 + 1);
     }
 }

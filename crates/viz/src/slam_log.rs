@@ -12,7 +12,7 @@
 //! once at the end.
 
 use crate::VizError;
-use crate::blueprint::{Layout, ViewKind};
+use crate::blueprint::{Layout, ViewKind, query};
 use crate::convert::{Rgba, color, lighten, pose_xy, ramp, robot_color, with_alpha};
 use crate::metrics::Level;
 use crate::paths;
@@ -227,10 +227,6 @@ impl SlamLogRecorder {
     }
 }
 
-fn q(prefix: char, p: &EntityPath, deep: bool) -> String {
-    if deep { format!("{prefix} {p}/**") } else { format!("{prefix} {p}") }
-}
-
 /// The layout of a SLAM run on a log: the map with the paths, particles and scan on the left; Neff, the
 /// real-time factor, the relations' errors and the events on the right.
 pub fn slam_layout(name: &str) -> Layout {
@@ -238,13 +234,13 @@ pub fn slam_layout(name: &str) -> Layout {
         ViewKind::Spatial2D,
         &format!("{name}: map, paths, particles, scan"),
         EntityPath::root(),
-        &[q('+', &paths::root("maps"), true), q('+', &paths::root("robots"), true)],
+        &[query('+', &paths::root("maps"), true), query('+', &paths::root("robots"), true)],
     );
     let series = |group: &str, title: &str| {
         let origin = paths::metric(group, &[]);
-        Layout::view(ViewKind::TimeSeries, title, origin.clone(), &[q('+', &origin, true)])
+        Layout::view(ViewKind::TimeSeries, title, origin.clone(), &[query('+', &origin, true)])
     };
-    let events = Layout::view(ViewKind::TextLog, "events", paths::events(), &[q('+', &paths::events(), false)]);
+    let events = Layout::view(ViewKind::TextLog, "events", paths::events(), &[query('+', &paths::events(), false)]);
     let side = Layout::Vertical(
         vec![
             series("neff", "Neff"),

@@ -4,7 +4,7 @@
 use super::agent::{Agent, Reading};
 use super::coordinate::Planner;
 use super::options::{RobotStep, RunError, RunOptions};
-use super::record::{viz_slam, viz_step};
+use super::record::{viz_slam, viz_step, viz_team};
 use super::team::Teams;
 use crate::controller::Controller;
 use crate::scenario::{MergeWhen, Scenario};
@@ -96,9 +96,12 @@ pub(super) fn drive(
             viz_slam(v, agents)?;
         }
         if let Some(tm) = teams.as_deref_mut() {
-            let joined = tm.after_step(sim.time(), agents, truth)?;
+            let step = tm.after_step(sim.time(), agents, truth)?;
+            if let Some(v) = opts.viz.as_deref_mut() {
+                viz_team(v, tm, agents, &step);
+            }
             if let Some(p) = planner.as_mut() {
-                p.replan(&joined);
+                p.replan(&step.joined);
             }
         }
     }

@@ -52,7 +52,7 @@ pub fn run(scenario: &Scenario, mut opts: RunOptions) -> Result<RunOutput, RunEr
     let mut agents = agent::add_robots(scenario, &mut sim, &truth)?;
     let algorithms = opts.algorithms.clone().unwrap_or_else(|| scenario.merge.algorithms.clone());
     if let Some(v) = opts.viz.as_deref_mut() {
-        record::viz_begin(v, &sim, &truth, &agents, &algorithms);
+        record::viz_begin(v, &sim, &truth, &agents, &algorithms, scenario.team.is_some());
     }
     let mut teams = scenario
         .team

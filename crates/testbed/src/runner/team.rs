@@ -19,6 +19,7 @@ use mrslam_core::{CellTraversal, OccupancyGrid, Pose2};
 use mrslam_merge::{MergeParams, Merger, fuse_maps as fuse, merge};
 use nalgebra::Point2;
 use std::collections::BTreeMap;
+use std::ops::Range;
 
 /// Header bytes of a ROS `nav_msgs/OccupancyGrid` message (header, map metadata, array length), as serialised.
 const GRID_HEADER_BYTES: u64 = 80;
@@ -49,6 +50,21 @@ impl Snapshot {
             .collect::<Result<_, _>>()?;
         Ok(Snapshot { maps })
     }
+}
+
+/// What the teams did in one step, for the planner and the recording.
+#[derive(Default)]
+pub(super) struct TeamStep {
+    /// Roots of the teams that grew (a merge was accepted).
+    pub joined: Vec<usize>,
+    /// Roots of the teams whose robots sent their maps to their team.
+    pub shared: Vec<usize>,
+    /// This step's merge attempts: their indices in `Teams::attempts`.
+    pub attempts: Range<usize>,
+    /// This step's coverage sample (time, share), when one was due.
+    pub sample: Option<[f64; 2]>,
+    /// The robots' maps the step used, when it took them.
+    pub snapshot: Option<Snapshot>,
 }
 
 /// The teams of a run and everything they did.
@@ -120,6 +136,17 @@ impl<'s> Teams<'s> {
         (self.root[k], self.place[k])
     }
 
+    /// Every merge attempt so far, in time order.
+    pub(super) fn attempts(&self) -> &[MergeAttempt] {
+        &self.attempts
+    }
+
+    /// Of the reachable free cells some robot's beams crossed so far, the share more than one robot's crossed.
+    pub(super) fn redundancy(&self, agents: &[Agent]) -> f64 {
+        let observed: Vec<&[bool]> = agents.iter().map(|a| &a.observed[..]).collect();
+        self.coverage.redundancy(&observed)
+    }
+
     /// Keeps a joint plan for the report.
     pub(super) fn record_plan(&mut self, plan: TeamPlan) {
         self.plans.push(plan);
@@ -145,13 +172,8 @@ impl<'s> Teams<'s> {
     }
 
     /// After a step: robots of different teams in contact exchange and try to merge their teams' maps; teammates
-    /// share their maps; coverage is sampled when due. Returns the roots of the teams that grew.
-    pub(super) fn after_step(
-        &mut self,
-        t: f64,
-        agents: &[Agent],
-        truth: &OccupancyGrid,
-    ) -> Result<Vec<usize>, RunError> {
+    /// share their maps; coverage is sampled when due.
+    pub(super) fn after_step(&mut self, t: f64, agents: &[Agent], truth: &OccupancyGrid) -> Result<TeamStep, RunError> {
         let n = agents.len();
         let frames: Vec<Option<Pose2>> = agents.iter().map(|a| a.processed.first().map(|p| p.0)).collect();
         let positions: Vec<Point2<f64>> = agents.iter().map(|a| Point2::from(a.last.translation.vector)).collect();
@@ -174,7 +196,7 @@ impl<'s> Teams<'s> {
             .collect();
         let coverage_due = t + 1e-9 >= self.next_coverage;
         if contacts.is_empty() && sharing.is_empty() && !coverage_due {
-            return Ok(Vec::new());
+            return Ok(TeamStep::default());
         }
         let snapshot = Snapshot::take(agents)?;
         for &k in &sharing {
@@ -184,6 +206,7 @@ impl<'s> Teams<'s> {
             }
         }
         let mut joined = Vec::new();
+        let first_attempt = self.attempts.len();
         for (a, b) in contacts {
             // An earlier contact of this step may have joined the two teams already.
             if self.root[a] == self.root[b] {
@@ -232,11 +255,16 @@ impl<'s> Teams<'s> {
                 joined.push(ra);
             }
         }
+        let mut sample = None;
         if coverage_due {
             self.next_coverage = t + self.setup.coverage_period;
             self.sample(t, &snapshot, &frames, truth);
+            sample = self.samples.last().copied();
         }
-        Ok(joined)
+        let mut shared: Vec<usize> = sharing.iter().map(|&k| self.root[k]).collect();
+        shared.sort_unstable();
+        shared.dedup();
+        Ok(TeamStep { joined, shared, attempts: first_attempt..self.attempts.len(), sample, snapshot: Some(snapshot) })
     }
 
     /// Samples the share of the reachable free area the robots' maps mark free.
@@ -270,7 +298,6 @@ impl<'s> Teams<'s> {
             self.sample(t, &snapshot, &frames, truth);
         }
         let reached = |share: f64| self.samples.iter().find(|s| s[1] >= share).map(|s| s[0]);
-        let observed: Vec<&[bool]> = agents.iter().map(|a| &a.observed[..]).collect();
         let roots = self.roots();
         let largest = roots.iter().copied().max_by_key(|&r| (self.members(r).len(), std::cmp::Reverse(r)));
         let team_map_acceptance = match largest {
@@ -290,7 +317,7 @@ impl<'s> Teams<'s> {
             time_to_90_s: reached(0.9),
             time_to_95_s: reached(0.95),
             distance_m: agents.iter().map(|a| a.distance).sum(),
-            redundancy: self.coverage.redundancy(&observed),
+            redundancy: self.redundancy(agents),
             first_correct_merge_s: self.attempts.iter().find(|a| a.correct).map(|a| a.time_s),
             merges_accepted: self.attempts.iter().filter(|a| a.accepted).count(),
             merges_refused: self.attempts.iter().filter(|a| !a.accepted).count(),
