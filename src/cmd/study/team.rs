@@ -15,12 +15,12 @@ use std::process::ExitCode;
 /// Arguments of `mrslam study team`.
 #[derive(Args)]
 pub struct TeamArgs {
-    /// Team scenario (TOML with a [team] table), e.g. scenarios/team_two_rooms.toml.
+    /// Team scenario (TOML with a `[team]` table), e.g. scenarios/team_two_rooms.toml.
     pub scenario: PathBuf,
     /// Output folder: study.json, results.csv, summary.csv, coverage.csv, plot.png, time90.png.
     #[arg(long)]
     pub out: PathBuf,
-    /// Numbers of robots: a trial takes the first N of the scenario's [[robots]]. A list a,b,c or start:stop
+    /// Numbers of robots: a trial takes the first N of the scenario's `[[robots]]`. A list a,b,c or start:stop
     /// (both included); default: all of them.
     #[arg(long)]
     pub robots: Option<String>,
