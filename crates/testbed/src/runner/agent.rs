@@ -35,9 +35,27 @@ pub(super) struct Agent<'s> {
     pub observed: Vec<bool>,
     /// The robot explores as one of a team whose planner gives it its paths (it does not plan on its own map).
     pub coordinated: bool,
+    /// The SLAM's map as last built, with the number of processed scans it was built after (see [`Agent::map`]).
+    map_cache: std::sync::Mutex<Option<(usize, OccupancyGrid)>>,
 }
 
 impl Agent<'_> {
+    /// The SLAM's current map, built once per processed scan while the robot drives: planning, coverage samples,
+    /// map exchanges and the recording all ask for it, and the SLAM rebuilds it from its whole trajectory on every
+    /// call. A skipped scan changes no trajectory node, so the map of the same processed count is the same map.
+    pub fn map(&self) -> Result<OccupancyGrid, RunError> {
+        let version = self.processed.len();
+        let mut cache = self.map_cache.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+        if let Some((v, map)) = cache.as_ref()
+            && *v == version
+        {
+            return Ok(map.clone());
+        }
+        let map = self.slam.map().map_err(|error| self.slam_error(error))?;
+        *cache = Some((version, map.clone()));
+        Ok(map)
+    }
+
     /// True once the controller is done.
     pub fn finished(&self) -> bool {
         self.controller.is_done()
@@ -57,14 +75,16 @@ impl Agent<'_> {
     /// The velocity command (m/s, rad/s) of this step, from the robot's true pose (a route is driven as an
     /// operator would, by looking at the robot) or its own map and pose (exploration is autonomous).
     pub fn command(&mut self, true_pose: &Pose2, dt: f64) -> Result<(f64, f64), RunError> {
+        let plans = matches!(&self.controller, Controller::Explore(e) if e.wants_plan())
+            && !self.processed.is_empty()
+            && !self.coordinated;
+        let map = if plans { Some(self.map()?) } else { None };
         match &mut self.controller {
             Controller::Waypoints(p) => Ok(p.command(true_pose, dt)),
             Controller::Explore(e) => {
                 let slam_pose = self.slam.best_pose();
-                if e.wants_plan() && !self.processed.is_empty() && !self.coordinated {
-                    let map =
-                        self.slam.map().map_err(|error| RunError::Slam { robot: self.setup.name.clone(), error })?;
-                    e.plan(&map, &slam_pose);
+                if let Some(map) = &map {
+                    e.plan(map, &slam_pose);
                 }
                 let (front, half_width) = self.setup.model.footprint.half_extents();
                 let reach = front + Explorer::STOP_DISTANCE;
@@ -157,6 +177,7 @@ pub(super) fn add_robots<'s>(
             slam_s: 0.0,
             observed: vec![false; truth.width() * truth.height()],
             coordinated: false,
+            map_cache: std::sync::Mutex::new(None),
         });
     }
     Ok(agents)

@@ -157,7 +157,7 @@ pub(super) fn viz_slam(v: &mut RunRecorder, agents: &[Agent]) -> Result<(), RunE
             v.paths(k, &traj);
         }
         if v.map_due(k) {
-            let map = a.slam.map().map_err(|error| a.slam_error(error))?;
+            let map = a.map()?;
             v.map(k, &map);
         }
     }

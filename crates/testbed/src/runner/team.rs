@@ -45,7 +45,7 @@ impl Snapshot {
                 if a.processed.is_empty() {
                     return Ok(None);
                 }
-                a.slam.map().map(Some).map_err(|e| a.slam_error(e))
+                a.map().map(Some)
             })
             .collect::<Result<_, _>>()?;
         Ok(Snapshot { maps })
