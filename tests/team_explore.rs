@@ -32,6 +32,11 @@ fn two_robots_merge_their_maps_when_they_meet_then_plan_together() {
     assert!(first < r.sim_s, "{first}");
     assert_eq!(team.teams.len(), 1, "one team at the end: {:?}", team.teams);
     assert!(team.bytes_exchanged > 0);
+    // A refused pair of teams tries again only once one of their maps has grown by a tenth.
+    for w in team.attempts.windows(2).filter(|w| !w[0].accepted && w[0].teams == w[1].teams) {
+        let grew = w[1].known_m2.iter().zip(&w[0].known_m2).any(|(now, then)| *now >= 1.1 * then);
+        assert!(grew, "tried again on the same maps: {w:?}");
+    }
     // After the merge the team plans together (one plan a second or faster while a robot wants a goal). In these
     // small rooms only one robot still has frontiers by then; that the planner splits frontiers between robots is
     // tested on maps in the crate (`team::tests`).

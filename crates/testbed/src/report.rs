@@ -180,6 +180,9 @@ pub struct MergeAttempt {
     pub robots: [String; 2],
     /// The robots of the host's team and of the other's before the try.
     pub teams: [Vec<String>; 2],
+    /// The area each team's map knew (free or occupied), m², host's first.
+    #[serde(default)]
+    pub known_m2: [f64; 2],
     /// Passed the merger's gate: the teams joined.
     pub accepted: bool,
     /// Accepted and within the scenario's success thresholds of the true transform; `false` when accepted

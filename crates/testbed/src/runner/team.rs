@@ -3,7 +3,9 @@
 //!
 //! Every robot starts as a team of its own, in its own SLAM frame. Two robots of different teams in contact
 //! (within the range, and in line of sight when the scenario asks) exchange their teams' maps at most once per
-//! exchange period and try to merge them with the scenario's team merger (the same gate as every merge); an
+//! exchange period and try to merge them with the scenario's team merger (the same gate as every merge), once both
+//! maps know the scenario's `min_known_m2` and, after a refused try, once one of them has grown by
+//! [`RETRY_GROWTH`]; an
 //! accepted transform joins the two teams, the host team's root frame becoming the frame of both. A team holds one
 //! map: its robots' current maps fused in the root's frame along the accepted transforms (a spanning tree: every
 //! join adds one edge between two teams). Once joined, a team's robots are taken to stay in touch (a relay through
@@ -20,6 +22,11 @@ use mrslam_merge::{MergeParams, Merger, fuse_maps as fuse, merge};
 use nalgebra::Point2;
 use std::collections::BTreeMap;
 use std::ops::Range;
+
+/// Two teams refused a merge try again only once one of their maps knows this share more area than at the refused
+/// try: the gate would weigh the same evidence again (robots that stand still keep meeting, and a try of two
+/// building-size maps costs 0.2-2 s).
+const RETRY_GROWTH: f64 = 0.1;
 
 /// Header bytes of a ROS `nav_msgs/OccupancyGrid` message (header, map metadata, array length), as serialised.
 const GRID_HEADER_BYTES: u64 = 80;
@@ -79,6 +86,8 @@ pub(super) struct Teams<'s> {
     place: Vec<Pose2>,
     /// Per pair of robots (a < b): when they may next exchange maps.
     next_exchange: BTreeMap<(usize, usize), f64>,
+    /// Per pair of team roots (host's first) refused at their last try: the areas their maps knew then, m².
+    refused: BTreeMap<(usize, usize), [f64; 2]>,
     /// Per robot: when it next sends its map to its team.
     next_share: Vec<f64>,
     next_coverage: f64,
@@ -109,6 +118,7 @@ impl<'s> Teams<'s> {
             root: (0..n).collect(),
             place: vec![Pose2::identity(); n],
             next_exchange: BTreeMap::new(),
+            refused: BTreeMap::new(),
             next_share: vec![0.0; n],
             next_coverage: 0.0,
             coverage: Coverage::new(truth, &starts, radius),
@@ -218,11 +228,23 @@ impl<'s> Teams<'s> {
             let (Some(map_a), Some(map_b)) = (self.team_map(ra, &snapshot), self.team_map(rb, &snapshot)) else {
                 continue;
             };
-            if known_m2(&map_a).min(known_m2(&map_b)) < self.setup.min_known_m2 {
+            let known = [known_m2(&map_a), known_m2(&map_b)];
+            if known[0].min(known[1]) < self.setup.min_known_m2 {
+                continue;
+            }
+            // The last refused try of these two teams stands until one of their maps has grown.
+            if let Some(last) = self.refused.get(&(ra, rb))
+                && known.iter().zip(last).all(|(now, then)| *now < then * (1.0 + RETRY_GROWTH))
+            {
                 continue;
             }
             self.bytes += message_bytes(&map_a) + message_bytes(&map_b);
             let out = merge(self.merger.as_ref(), &map_a, &map_b, &self.params);
+            if out.report.accepted {
+                self.refused.remove(&(ra, rb));
+            } else {
+                self.refused.insert((ra, rb), known);
+            }
             let (fa, fb) = (frames[ra].unwrap_or_default(), frames[rb].unwrap_or_default());
             let true_t = fa.inv_mul(&fb);
             let err = out.report.transform.map(|x| transform_error(&x.to_pose(), &true_t));
@@ -236,6 +258,7 @@ impl<'s> Teams<'s> {
                 time_s: t,
                 robots: [name(host), name(other)],
                 teams: [team_names(ra), team_names(rb)],
+                known_m2: known,
                 accepted: out.report.accepted,
                 correct,
                 rotation_error_deg: err.map(|e| e.0.to_degrees()),
