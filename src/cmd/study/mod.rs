@@ -51,6 +51,20 @@ pub fn run(cmd: StudyCommand) -> Result<ExitCode> {
     }
 }
 
+/// The flags every sharded study takes: which shard, whether to resume, whether to draw progress.
+#[derive(clap::Args)]
+pub struct StudyRun {
+    /// Run only shard K of N (trial index mod N = K); default from SLURM_ARRAY_TASK_ID/SLURM_ARRAY_TASK_COUNT.
+    #[arg(long)]
+    pub shard: Option<String>,
+    /// No progress bar.
+    #[arg(long)]
+    pub quiet: bool,
+    /// Continue the interrupted study in --out: run only the trials its results.csv lacks.
+    #[arg(long)]
+    pub resume: bool,
+}
+
 pub(super) fn shard_of(arg: Option<&str>) -> Result<Shard> {
     Ok(match arg {
         Some(s) => Shard::parse(s).context("--shard")?,

@@ -45,9 +45,9 @@ pub struct OverlapArgs {
     /// Output folder: study.json, results.csv, summary.csv, plot.png.
     #[arg(long)]
     pub out: PathBuf,
-    /// Run only shard K of N (trial index mod N = K); default from SLURM_ARRAY_TASK_ID/SLURM_ARRAY_TASK_COUNT.
-    #[arg(long)]
-    pub shard: Option<String>,
+    /// Sharding, resuming and progress.
+    #[command(flatten)]
+    pub run: super::StudyRun,
     /// Study seed: every trial is seeded from (seed, overlap index, trial index).
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
@@ -67,12 +67,6 @@ pub struct OverlapArgs {
     /// The SIFT merger's map-to-image encoding: `walls` (the default) or `paper` (unknown grey).
     #[arg(long, default_value = "walls", value_parser = one_of::<Encoding>(Encoding::ALL.map(Encoding::name)))]
     pub encoding: Encoding,
-    /// No progress bar.
-    #[arg(long)]
-    pub quiet: bool,
-    /// Continue the interrupted study in --out: run only the trials its results.csv lacks.
-    #[arg(long)]
-    pub resume: bool,
 }
 
 fn floorplan_size(s: &str) -> Result<(f64, f64)> {
@@ -84,7 +78,7 @@ fn floorplan_size(s: &str) -> Result<(f64, f64)> {
 
 /// Runs `mrslam study overlap`.
 pub(super) fn run(a: OverlapArgs) -> Result<ExitCode> {
-    let shard = shard_of(a.shard.as_deref())?;
+    let shard = shard_of(a.run.shard.as_deref())?;
     let overlaps = parse_range(&a.overlaps).context("--overlaps")?;
     if a.trials == 0 {
         bail!("--trials must be at least 1");
@@ -138,10 +132,10 @@ pub(super) fn run(a: OverlapArgs) -> Result<ExitCode> {
         .set("map_style", &a.map_style)
         .set("encoding", a.encoding);
     let inputs = a.map.iter().chain(&a.world).map(PathBuf::as_path);
-    let (journal, earlier) = open_study(&a.out, inputs, &[], &params, algorithms.len(), a.resume)?;
+    let (journal, earlier) = open_study(&a.out, inputs, &[], &params, algorithms.len(), a.run.resume)?;
     let selected: Vec<usize> = study.selected_trials().iter().map(|t| t.trial).collect();
     let (mut rows, n, seconds) =
-        run_study(earlier, journal, &selected, a.quiet, "overlap study", |p| run_overlap_study(&study, p))?;
+        run_study(earlier, journal, &selected, a.run.quiet, "overlap study", |p| run_overlap_study(&study, p))?;
     sort_rows(&mut rows, &algorithms);
     finish(&rows, &a.out, n, Some(seconds))
 }

@@ -17,23 +17,17 @@ pub struct ScenarioArgs {
     /// Output folder: study.json, results.csv, summary.csv, plot.png.
     #[arg(long)]
     pub out: PathBuf,
-    /// Run only shard K of N (trial index mod N = K); default from SLURM_ARRAY_TASK_ID/SLURM_ARRAY_TASK_COUNT.
-    #[arg(long)]
-    pub shard: Option<String>,
-    /// No progress bar.
-    #[arg(long)]
-    pub quiet: bool,
+    /// Sharding, resuming and progress.
+    #[command(flatten)]
+    pub run: super::StudyRun,
     /// Read and check the sweep, list its trials, run nothing.
     #[arg(long)]
     pub dry_run: bool,
-    /// Continue the interrupted study in --out: run only the trials its results.csv lacks.
-    #[arg(long)]
-    pub resume: bool,
 }
 
 /// Runs `mrslam study scenario`.
 pub(super) fn run(a: ScenarioArgs) -> Result<ExitCode> {
-    let shard = shard_of(a.shard.as_deref())?;
+    let shard = shard_of(a.run.shard.as_deref())?;
     let sweep = Sweep::from_file(&a.sweep)?;
     if a.dry_run {
         println!(
@@ -69,10 +63,10 @@ pub(super) fn run(a: ScenarioArgs) -> Result<ExitCode> {
     params.set("algorithms", algorithms.join(","));
     params.set("seeds", sweep.seeds.iter().map(u64::to_string).collect::<Vec<_>>().join(","));
     let inputs = [sweep.path.as_path(), sweep.scenario.path.as_path(), sweep.scenario.world_path.as_path()];
-    let (journal, earlier) = open_study(&a.out, inputs, &[], &params, algorithms.len(), a.resume)?;
+    let (journal, earlier) = open_study(&a.out, inputs, &[], &params, algorithms.len(), a.run.resume)?;
     let selected: Vec<usize> = (0..sweep.trials()).filter(|t| shard.selects(*t)).collect();
     let (mut rows, n, seconds) =
-        run_study(earlier, journal, &selected, a.quiet, &sweep.scenario.name, |p| run_sweep(&sweep, shard, p))?;
+        run_study(earlier, journal, &selected, a.run.quiet, &sweep.scenario.name, |p| run_sweep(&sweep, shard, p))?;
     sort_rows(&mut rows, &algorithms);
     finish(&rows, &a.out, n, Some(seconds))
 }

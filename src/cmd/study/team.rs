@@ -20,6 +20,9 @@ pub struct TeamArgs {
     /// Output folder: study.json, results.csv, summary.csv, coverage.csv, plot.png, time90.png.
     #[arg(long)]
     pub out: PathBuf,
+    /// Sharding, resuming and progress.
+    #[command(flatten)]
+    pub run: super::StudyRun,
     /// Numbers of robots: a trial takes the first N of the scenario's `[[robots]]`. A list a,b,c or start:stop
     /// (both included); default: all of them.
     #[arg(long)]
@@ -40,18 +43,9 @@ pub struct TeamArgs {
     /// Simulated seconds a run lasts at most, instead of the scenario's duration.
     #[arg(long)]
     pub duration: Option<f64>,
-    /// Run only shard K of N (trial index mod N = K); default from SLURM_ARRAY_TASK_ID/SLURM_ARRAY_TASK_COUNT.
-    #[arg(long)]
-    pub shard: Option<String>,
-    /// No progress bar.
-    #[arg(long)]
-    pub quiet: bool,
     /// Read and check the scenario and the lists, list the trials, run nothing.
     #[arg(long)]
     pub dry_run: bool,
-    /// Continue the interrupted study in --out: run only the trials its results.csv lacks.
-    #[arg(long)]
-    pub resume: bool,
 }
 
 /// Each comma-separated name of `s` read by `T`'s parser; `flag` names the list in errors.
@@ -94,7 +88,7 @@ fn joined<T: std::fmt::Display>(values: &[T]) -> String {
 
 /// Runs `mrslam study team`.
 pub(super) fn run(a: TeamArgs) -> Result<ExitCode> {
-    let shard = shard_of(a.shard.as_deref())?;
+    let shard = shard_of(a.run.shard.as_deref())?;
     let study = study_of(&a)?;
     let selected: Vec<usize> = (0..study.trials()).filter(|t| shard.selects(*t)).collect();
     let runs: BTreeSet<usize> = selected.iter().map(|&t| study.run_of(t)).collect();
@@ -135,9 +129,10 @@ pub(super) fn run(a: TeamArgs) -> Result<ExitCode> {
         .set("coverage_step", study.coverage_step());
     let inputs = [study.scenario.path.as_path(), study.scenario.world_path.as_path()];
     let more: Vec<PathBuf> = ["coverage.csv", "time90.png"].iter().map(|f| a.out.join(f)).collect();
-    let (journal, earlier) = open_study::<TeamRow>(&a.out, inputs, &more, &params, 1, a.resume)?;
-    let (rows, n, seconds) =
-        run_study(earlier, journal, &selected, a.quiet, &study.scenario.name, |p| run_team_study(&study, shard, p))?;
+    let (journal, earlier) = open_study::<TeamRow>(&a.out, inputs, &more, &params, 1, a.run.resume)?;
+    let (rows, n, seconds) = run_study(earlier, journal, &selected, a.run.quiet, &study.scenario.name, |p| {
+        run_team_study(&study, shard, p)
+    })?;
     finish(&rows, &a.out, n, Some(seconds))
 }
 
