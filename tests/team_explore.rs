@@ -39,7 +39,7 @@ fn two_robots_merge_their_maps_when_they_meet_then_plan_together() {
     }
     // After the merge the team plans together (one plan a second or faster while a robot wants a goal). In these
     // small rooms only one robot still has frontiers by then; that the planner splits frontiers between robots is
-    // tested on maps in the crate (`team::tests`).
+    // tested on maps in the crate (`joint_plan::tests`).
     let joint = team.plans.iter().filter(|p| p.time_s >= first && p.targets.len() == 2).count();
     assert!(joint > 0, "no joint plan after the merge at {first} s: {:?}", team.plans);
     // The rooms are mapped: coverage of the reachable free area against the truth.

@@ -18,7 +18,7 @@ pub mod assignment;
 pub mod controller;
 pub mod eval;
 pub mod frontier;
+pub mod joint_plan;
 pub mod report;
 pub mod runner;
 pub mod scenario;
-pub mod team;

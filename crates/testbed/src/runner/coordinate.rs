@@ -6,8 +6,8 @@ use super::options::RunError;
 use super::team::{Snapshot, Teams};
 use crate::assignment::AssignParams;
 use crate::controller::{Controller, Explorer};
+use crate::joint_plan::{Member, TeamParams, plan_team};
 use crate::report::TeamPlan;
-use crate::team::{Member, TeamParams, plan_team};
 use nalgebra::Point2;
 
 /// When each team plans next, and each robot's current target (its own SLAM frame), for display.
