@@ -261,6 +261,12 @@ impl OccupancyGrid {
             .collect()
     }
 
+    /// The area the grid knows (free or occupied cells), m².
+    pub fn known_area(&self) -> f64 {
+        let (free, occupied, _) = self.state_counts();
+        (free + occupied) as f64 * self.resolution * self.resolution
+    }
+
     /// Counts of (free, occupied, unknown) cells.
     pub fn state_counts(&self) -> (usize, usize, usize) {
         let (mut f, mut o, mut u) = (0, 0, 0);

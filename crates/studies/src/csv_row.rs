@@ -2,8 +2,9 @@
 //! row, each row belonging to one trial), so that one journal resumes them all and one reader checks them.
 
 use crate::StudyError;
+use std::collections::BTreeMap;
 use std::fmt::Write as _;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// A row of a study's `results.csv`: written as one CSV line under [`CsvRow::HEADER`], read back from it.
 pub trait CsvRow: Sized {
@@ -55,4 +56,39 @@ pub(crate) fn rows_text<R: CsvRow>(rows: &[R]) -> String {
 /// Writes `rows` under their header at `path` (through a temporary file).
 pub(crate) fn write_rows<R: CsvRow>(rows: &[R], path: &Path) -> Result<(), StudyError> {
     mrslam_core::output::write_file_atomic(path, rows_text(rows).as_bytes()).map_err(|e| StudyError::file(path, e))
+}
+
+/// Joins the `results.csv` of a study's shard folders, in folder then line order, refusing a row whose `key`
+/// (what one row of the study is: a trial, or a trial and an algorithm) came already; `name` says which row in
+/// that error ("trial 3", "trial 3 of `sift`").
+pub(crate) fn collect_rows<R: CsvRow, K: Ord>(
+    dirs: &[PathBuf],
+    key: impl Fn(&R) -> K,
+    name: impl Fn(&R) -> String,
+) -> Result<Vec<R>, StudyError> {
+    if dirs.is_empty() {
+        return Err(StudyError::Invalid("collect: no shard folders given".into()));
+    }
+    let mut seen: BTreeMap<K, (PathBuf, usize)> = BTreeMap::new();
+    let mut all = Vec::new();
+    for d in dirs {
+        let path = d.join("results.csv");
+        for (line, r) in read_rows::<R>(&path)? {
+            if let Some((first, first_line)) = seen.insert(key(&r), (path.clone(), line)) {
+                let message = format!(
+                    "{} is also in {}:{first_line}: shards overlap (same shard collected twice?)",
+                    name(&r),
+                    first.display()
+                );
+                return Err(StudyError::Results { path, line, message });
+            }
+            all.push(r);
+        }
+    }
+    Ok(all)
+}
+
+/// A number with `digits` decimals, or an empty column for none.
+pub(crate) fn optional(v: Option<f64>, digits: usize) -> String {
+    v.map_or(String::new(), |x| format!("{x:.digits$}"))
 }

@@ -33,6 +33,21 @@ pub fn register_sans_serif() {
     });
 }
 
+/// Draws the legend of `chart`'s labelled series at `position`: the one legend style of the studies' plots.
+pub(crate) fn draw_legend<'a, DB: DrawingBackend + 'a, CT: CoordTranslate>(
+    chart: &mut ChartContext<'a, DB, CT>,
+    position: SeriesLabelPosition,
+) -> Result<(), String> {
+    chart
+        .configure_series_labels()
+        .position(position)
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 18))
+        .draw()
+        .map_err(|e| e.to_string())
+}
+
 /// Draws the summary into an RGB buffer of [`WIDTH`] × [`HEIGHT`].
 pub fn render(summary: &[SummaryRow]) -> Result<Vec<u8>, String> {
     register_sans_serif();
@@ -89,14 +104,7 @@ pub fn render(summary: &[SummaryRow]) -> Result<Vec<u8>, String> {
                 .label(format!("{alg} false merges"))
                 .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], c.stroke_width(1)));
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperLeft)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font(("sans-serif", 18))
-            .draw()
-            .map_err(|e| e.to_string())?;
+        draw_legend(&mut chart, SeriesLabelPosition::UpperLeft)?;
 
         let times: Vec<f64> = summary.iter().map(|r| r.median_time_ms).filter(|t| t.is_finite() && *t > 0.0).collect();
         let t_hi = times.iter().copied().fold(0.0f64, f64::max);
@@ -131,14 +139,7 @@ pub fn render(summary: &[SummaryRow]) -> Result<Vec<u8>, String> {
                 .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], c.stroke_width(3)));
             chart.draw_series(line.iter().map(|&p| Circle::new(p, 5, c.filled()))).map_err(|e| e.to_string())?;
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font(("sans-serif", 18))
-            .draw()
-            .map_err(|e| e.to_string())?;
+        draw_legend(&mut chart, SeriesLabelPosition::UpperRight)?;
         root.present().map_err(|e| e.to_string())?;
     }
     Ok(buf)

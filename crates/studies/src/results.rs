@@ -7,8 +7,7 @@
 //! map-level studies (a cut pair has no SLAM drift: its truth is exact). Booleans are `true`/`false`.
 
 use super::StudyError;
-use super::csv_row::{CsvRow, parse_rows, read_rows, write_rows};
-use std::collections::BTreeMap;
+use super::csv_row::{CsvRow, collect_rows, optional, parse_rows, read_rows, write_rows};
 use std::path::{Path, PathBuf};
 
 /// The header line of `results.csv`.
@@ -52,10 +51,6 @@ pub struct TrialRow {
     pub stage: String,
 }
 
-fn opt(v: Option<f64>, digits: usize) -> String {
-    v.map_or(String::new(), |x| format!("{x:.digits$}"))
-}
-
 /// Every column but `time_ms` is a pure function of the trial.
 impl CsvRow for TrialRow {
     const HEADER: &'static str = HEADER;
@@ -75,11 +70,11 @@ impl CsvRow for TrialRow {
             self.accepted,
             self.success,
             self.false_merge,
-            opt(self.rotation_error_deg, 6),
-            opt(self.translation_error_m, 6),
+            optional(self.rotation_error_deg, 6),
+            optional(self.translation_error_m, 6),
             self.time_ms,
-            opt(self.rotation_error_at_end_deg, 6),
-            opt(self.translation_error_at_end_m, 6),
+            optional(self.rotation_error_at_end_deg, 6),
+            optional(self.translation_error_at_end_m, 6),
             self.stage,
         )
     }
@@ -149,31 +144,15 @@ pub fn parse_results(text: &str, path: &Path) -> Result<Vec<TrialRow>, StudyErro
 /// Joins the `results.csv` of several shard folders, refusing a (trial, algorithm) found twice.
 /// Rows come back sorted by trial, then algorithm in order of first appearance.
 pub fn collect(dirs: &[PathBuf]) -> Result<Vec<TrialRow>, StudyError> {
-    if dirs.is_empty() {
-        return Err(StudyError::Invalid("collect: no shard folders given".into()));
-    }
-    let mut seen: BTreeMap<(usize, String), (PathBuf, usize)> = BTreeMap::new();
+    let mut all = collect_rows(
+        dirs,
+        |r: &TrialRow| (r.trial, r.algorithm.clone()),
+        |r| format!("trial {} of `{}`", r.trial, r.algorithm),
+    )?;
     let mut order: Vec<String> = Vec::new();
-    let mut all = Vec::new();
-    for d in dirs {
-        let path = d.join("results.csv");
-        for (line, r) in read_rows::<TrialRow>(&path)? {
-            if let Some((first, first_line)) = seen.insert((r.trial, r.algorithm.clone()), (path.clone(), line)) {
-                return Err(StudyError::Results {
-                    path,
-                    line,
-                    message: format!(
-                        "trial {} of `{}` is also in {}:{first_line}: shards overlap (same shard collected twice?)",
-                        r.trial,
-                        r.algorithm,
-                        first.display()
-                    ),
-                });
-            }
-            if !order.contains(&r.algorithm) {
-                order.push(r.algorithm.clone());
-            }
-            all.push(r);
+    for r in &all {
+        if !order.contains(&r.algorithm) {
+            order.push(r.algorithm.clone());
         }
     }
     sort_rows(&mut all, &order);

@@ -54,12 +54,6 @@ fn cross_check_refusal(
     }
 }
 
-/// The area a map knows (free or occupied), m².
-fn known_area(g: &OccupancyGrid) -> f64 {
-    let (free, occupied, _) = g.state_counts();
-    (free + occupied) as f64 * g.resolution() * g.resolution()
-}
-
 impl CorrelativeMerger {
     /// The poses that pass the significance test and the shared-area check, best first, and b's wall points (b's
     /// frame, thinned) that weigh them; else why none does.
@@ -80,7 +74,7 @@ impl CorrelativeMerger {
         let (poses, tried) = self.shared(a, b, &refined, min_overlap_m2);
         timings.insert("overlap".into(), ms(t));
         if poses.is_empty() {
-            let smaller = known_area(a).min(known_area(b));
+            let smaller = a.known_area().min(b.known_area());
             let reason = if smaller < min_overlap_m2 {
                 format!(
                     "the correlative stage accepts a pose only where the maps share {min_overlap_m2:.1} m² of known \

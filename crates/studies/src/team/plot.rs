@@ -6,7 +6,7 @@
 use super::coverage::CoverageCurve;
 use super::summary::{ConfigKey, TeamSummaryRow};
 use crate::StudyError;
-use crate::plot::{COLOURS, HEIGHT, WIDTH, register_sans_serif, write_rgb_png};
+use crate::plot::{COLOURS, HEIGHT, WIDTH, draw_legend, register_sans_serif, write_rgb_png};
 use plotters::prelude::*;
 use std::path::Path;
 
@@ -129,14 +129,7 @@ pub fn render_coverage(curves: &[CoverageCurve]) -> Result<Vec<u8>, String> {
         }
         let ninety = vec![(0.0, 0.9), (t_max, 0.9)];
         chart.draw_series(std::iter::once(PathElement::new(ninety, BLACK.mix(0.4)))).map_err(chart_err)?;
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::LowerRight)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font(("sans-serif", 18))
-            .draw()
-            .map_err(chart_err)?;
+        draw_legend(&mut chart, SeriesLabelPosition::LowerRight)?;
         root.present().map_err(chart_err)?;
     }
     Ok(buf)
@@ -232,14 +225,7 @@ pub fn render_time90(summary: &[TeamSummaryRow]) -> Result<Vec<u8>, String> {
                 chart.draw_series(std::iter::once(Text::new(text, (x + cap + 0.01, y), style))).map_err(chart_err)?;
             }
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font(("sans-serif", 18))
-            .draw()
-            .map_err(chart_err)?;
+        draw_legend(&mut chart, SeriesLabelPosition::UpperRight)?;
         root.present().map_err(chart_err)?;
     }
     Ok(buf)

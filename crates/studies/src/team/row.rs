@@ -6,10 +6,9 @@
 //! mapped at t = 0, step, 2 step, … up to the study's duration (`coverage_step_s` apart), space-separated.
 
 use crate::StudyError;
-use crate::csv_row::{CsvRow, read_rows};
+use crate::csv_row::{CsvRow, collect_rows, optional, read_rows};
 use mrslam_merge::Algorithm;
 use mrslam_testbed::scenario::Coordination;
-use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 /// The header line of a team study's `results.csv`.
@@ -73,10 +72,6 @@ pub struct TeamRow {
     pub coverage: Vec<f64>,
 }
 
-fn opt(v: Option<f64>, digits: usize) -> String {
-    v.map_or(String::new(), |x| format!("{x:.digits$}"))
-}
-
 impl CsvRow for TeamRow {
     const HEADER: &'static str = TEAM_HEADER;
 
@@ -94,18 +89,18 @@ impl CsvRow for TeamRow {
             self.coordination,
             self.merger,
             self.seed,
-            opt(self.time_to_50_s, 3),
-            opt(self.time_to_90_s, 3),
-            opt(self.time_to_95_s, 3),
+            optional(self.time_to_50_s, 3),
+            optional(self.time_to_90_s, 3),
+            optional(self.time_to_95_s, 3),
             self.final_coverage,
             self.redundancy,
             self.distance_m,
-            opt(self.first_correct_merge_s, 3),
+            optional(self.first_correct_merge_s, 3),
             self.merges_accepted,
             self.merges_refused,
             self.merges_false,
             self.bytes_exchanged,
-            opt(self.team_map_acceptance, 6),
+            optional(self.team_map_acceptance, 6),
             self.wall_s,
             self.teams_at_end,
             self.reachable_m2,
@@ -170,28 +165,7 @@ impl CsvRow for TeamRow {
 /// Joins the `results.csv` of a team study's shard folders, refusing a trial found twice; rows come back sorted
 /// by trial.
 pub fn collect_team(dirs: &[PathBuf]) -> Result<Vec<TeamRow>, StudyError> {
-    if dirs.is_empty() {
-        return Err(StudyError::Invalid("collect: no shard folders given".into()));
-    }
-    let mut seen: BTreeMap<usize, (PathBuf, usize)> = BTreeMap::new();
-    let mut all = Vec::new();
-    for d in dirs {
-        let path = d.join("results.csv");
-        for (line, r) in read_rows::<TeamRow>(&path)? {
-            if let Some((first, first_line)) = seen.insert(r.trial, (path.clone(), line)) {
-                return Err(StudyError::Results {
-                    path,
-                    line,
-                    message: format!(
-                        "trial {} is also in {}:{first_line}: shards overlap (same shard collected twice?)",
-                        r.trial,
-                        first.display()
-                    ),
-                });
-            }
-            all.push(r);
-        }
-    }
+    let mut all = collect_rows(dirs, |r: &TeamRow| r.trial, |r| format!("trial {}", r.trial))?;
     all.sort_by_key(|r| r.trial);
     Ok(all)
 }

@@ -36,7 +36,7 @@ pub(super) struct Agent<'s> {
     /// The robot explores as one of a team whose planner gives it its paths (it does not plan on its own map).
     pub coordinated: bool,
     /// The SLAM's map as last built, with the number of processed scans it was built after (see [`Agent::map`]).
-    map_cache: std::sync::Mutex<Option<(usize, OccupancyGrid)>>,
+    map_cache: std::cell::RefCell<Option<(usize, OccupancyGrid)>>,
 }
 
 impl Agent<'_> {
@@ -45,7 +45,7 @@ impl Agent<'_> {
     /// call. A skipped scan changes no trajectory node, so the map of the same processed count is the same map.
     pub fn map(&self) -> Result<OccupancyGrid, RunError> {
         let version = self.processed.len();
-        let mut cache = self.map_cache.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+        let mut cache = self.map_cache.borrow_mut();
         if let Some((v, map)) = cache.as_ref()
             && *v == version
         {
@@ -54,6 +54,12 @@ impl Agent<'_> {
         let map = self.slam.map().map_err(|error| self.slam_error(error))?;
         *cache = Some((version, map.clone()));
         Ok(map)
+    }
+
+    /// Where the robot's SLAM frame lies in the world: its true pose at its first processed scan (the truth the
+    /// evaluation places its map by); `None` before that scan.
+    pub fn frame(&self) -> Option<Pose2> {
+        self.processed.first().map(|p| p.0)
     }
 
     /// True once the controller is done.
@@ -177,7 +183,7 @@ pub(super) fn add_robots<'s>(
             slam_s: 0.0,
             observed: vec![false; truth.width() * truth.height()],
             coordinated: false,
-            map_cache: std::sync::Mutex::new(None),
+            map_cache: std::cell::RefCell::new(None),
         });
     }
     Ok(agents)

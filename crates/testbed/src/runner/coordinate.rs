@@ -10,14 +10,12 @@ use crate::joint_plan::{Member, TeamParams, plan_team};
 use crate::report::TeamPlan;
 use nalgebra::Point2;
 
-/// When each team plans next, and each robot's current target (its own SLAM frame), for display.
+/// When each team plans next.
 pub(super) struct Planner {
     /// Per team root: the time of its next plan.
     next: Vec<f64>,
     /// Per team root: the time of its last plan.
     last: Vec<f64>,
-    /// Per robot: the frontier it drives to, in its own SLAM frame.
-    pub targets: Vec<Option<Point2<f64>>>,
     params: TeamParams,
 }
 
@@ -27,7 +25,6 @@ impl Planner {
         Planner {
             next: vec![0.0; robots],
             last: vec![f64::NEG_INFINITY; robots],
-            targets: vec![None; robots],
             params: TeamParams { assign: AssignParams { beta, ..AssignParams::default() }, ..TeamParams::default() },
         }
     }
@@ -96,7 +93,6 @@ impl Planner {
                 let to_own = place.inverse();
                 let a = &mut agents[k];
                 a.coordinated = true;
-                self.targets[k] = plan.as_ref().map(|p| to_own * p.target);
                 let Controller::Explore(e) = &mut a.controller else { continue };
                 match plan {
                     Some(p) => e.follow(p.path.iter().map(|q| to_own * q).collect()),

@@ -149,7 +149,7 @@ pub(super) fn viz_slam(v: &mut RunRecorder, agents: &[Agent]) -> Result<(), RunE
             hypotheses: &hypotheses.poses,
             effective: hypotheses.effective,
             resamples: a.slam.counters().resamples,
-            frame: a.processed.first().map(|p| p.0),
+            frame: a.frame(),
         };
         v.slam(k, state);
         if v.paths_due(k) {

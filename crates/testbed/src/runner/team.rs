@@ -5,10 +5,9 @@
 //! (within the range, and in line of sight when the scenario asks) exchange their teams' maps at most once per
 //! exchange period and try to merge them with the scenario's team merger (the same gate as every merge), once both
 //! maps know the scenario's `min_known_m2` and, after a refused try, once one of them has grown by
-//! [`RETRY_GROWTH`]; an
-//! accepted transform joins the two teams, the host team's root frame becoming the frame of both. A team holds one
-//! map: its robots' current maps fused in the root's frame along the accepted transforms (a spanning tree: every
-//! join adds one edge between two teams). Once joined, a team's robots are taken to stay in touch (a relay through
+//! [`RETRY_GROWTH`]; an accepted transform joins the two teams, the host team's root frame becoming the frame of
+//! both. A team holds one map: its robots' current maps fused in the root's frame along the accepted transforms (a
+//! spanning tree: every join adds one edge between two teams). Once joined, a team's robots are taken to stay in touch (a relay through
 //! teammates): each sends its map to the team once per exchange period, and those bytes are counted too.
 
 use super::agent::Agent;
@@ -36,8 +35,7 @@ fn message_bytes(map: &OccupancyGrid) -> u64 {
     GRID_HEADER_BYTES + (map.width() * map.height()) as u64
 }
 
-/// What a team needs of a robot's state at one moment: its map (if it has one yet) and where its SLAM frame lies
-/// in the world (for the evaluation only).
+/// Every robot's map at one moment (if it has one yet).
 pub(super) struct Snapshot {
     /// Each robot's current map in its own SLAM frame; `None` before its first processed scan.
     pub maps: Vec<Option<OccupancyGrid>>,
@@ -185,7 +183,7 @@ impl<'s> Teams<'s> {
     /// share their maps; coverage is sampled when due.
     pub(super) fn after_step(&mut self, t: f64, agents: &[Agent], truth: &OccupancyGrid) -> Result<TeamStep, RunError> {
         let n = agents.len();
-        let frames: Vec<Option<Pose2>> = agents.iter().map(|a| a.processed.first().map(|p| p.0)).collect();
+        let frames: Vec<Option<Pose2>> = agents.iter().map(Agent::frame).collect();
         let positions: Vec<Point2<f64>> = agents.iter().map(|a| Point2::from(a.last.translation.vector)).collect();
         let mut contacts = Vec::new();
         for a in 0..n {
@@ -228,7 +226,7 @@ impl<'s> Teams<'s> {
             let (Some(map_a), Some(map_b)) = (self.team_map(ra, &snapshot), self.team_map(rb, &snapshot)) else {
                 continue;
             };
-            let known = [known_m2(&map_a), known_m2(&map_b)];
+            let known = [map_a.known_area(), map_b.known_area()];
             if known[0].min(known[1]) < self.setup.min_known_m2 {
                 continue;
             }
@@ -316,7 +314,7 @@ impl<'s> Teams<'s> {
     /// truth.
     pub(super) fn report(mut self, t: f64, agents: &[Agent], truth: &OccupancyGrid) -> Result<TeamReport, RunError> {
         let snapshot = Snapshot::take(agents)?;
-        let frames: Vec<Option<Pose2>> = agents.iter().map(|a| a.processed.first().map(|p| p.0)).collect();
+        let frames: Vec<Option<Pose2>> = agents.iter().map(Agent::frame).collect();
         if self.samples.last().is_none_or(|s| s[0] < t - 1e-9) {
             self.sample(t, &snapshot, &frames, truth);
         }
@@ -353,12 +351,6 @@ impl<'s> Teams<'s> {
             plans: self.plans,
         })
     }
-}
-
-/// The area `map` knows (free or occupied), m².
-fn known_m2(map: &OccupancyGrid) -> f64 {
-    let (free, occupied, _) = map.state_counts();
-    (free + occupied) as f64 * map.resolution() * map.resolution()
 }
 
 /// An unknown grid with `map`'s geometry (the fusion's frame when a team's root has no map yet).
