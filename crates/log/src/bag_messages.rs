@@ -139,6 +139,11 @@ impl BagMessages {
         Ok(())
     }
 
+    /// The most bytes the bag's messages may hold ([`ReadOptions::max_bytes`](crate::ReadOptions::max_bytes)).
+    pub(crate) fn max_bytes(&self) -> u64 {
+        self.max_bytes
+    }
+
     /// An error about this bag.
     pub(crate) fn error(&self, message: String) -> LogError {
         LogError::Bag { path: self.path.clone(), message }

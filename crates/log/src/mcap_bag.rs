@@ -11,7 +11,12 @@
 //! record ([`prefixes_fit`]): `mcap::parse_record` reserves what a string's prefix claims before reading it.
 //! A third keeps the crate from walking past an uncompressed chunk: `mcap_frames` checks its records' framing.
 //! A fourth keeps it from spinning forever on a compressed chunk that holds less than it declares: each
-//! chunk is read by a reader of its own that sees nothing past the chunk ([`read_chunk`]).
+//! chunk is read by a reader of its own that sees nothing past the chunk ([`read_chunk`]). A fifth keeps a
+//! compressed chunk from claiming memory its bytes cannot fill: the crate reserves (and zeroes) a chunk's
+//! declared uncompressed size, and a record's claimed length within it, before it decompresses; a chunk that
+//! declares more than its compressed bytes can expand to ([`max_expansion`]) or more than the log may hold
+//! ([`ReadOptions::max_bytes`](crate::ReadOptions::max_bytes)) is refused first, and no record in it may claim
+//! more than the chunk declares.
 
 use crate::bag_messages::{BagMessages, MAX_RECORD_BYTES, Wire};
 use crate::error::LogError;
@@ -173,14 +178,33 @@ fn read_chunk(at: u64, body: &[u8], records: &mut Records) -> Result<(), LogErro
     let path = records.bag.path.clone();
     let err =
         |what: &str| LogError::Bag { path: path.clone(), message: format!("MCAP, the chunk at byte {at}: {what}") };
-    let Some((declared, compressed, chunk)) = chunk_parts(body) else {
+    let Some(parts) = chunk_parts(body) else {
         return Err(err("its fields run past the end of its record"));
     };
+    let ChunkParts { declared, compression, compressed_bytes, chunk } = parts;
+    let compressed = !compression.is_empty();
+    // The declared size is what the crate reserves before decompressing: bounded by what the compressed
+    // bytes can expand to, and by the log's bound.
+    if let Some(ratio) = max_expansion(compression)
+        && declared > compressed_bytes.saturating_mul(ratio)
+    {
+        return Err(err(&format!(
+            "it declares {declared} bytes uncompressed from {compressed_bytes} bytes of {compression}, more than \
+                 {compression} can expand them to (at most {ratio} times): a corrupt or hostile file"
+        )));
+    }
+    let max_bytes = records.bag.max_bytes();
+    if compressed && declared > max_bytes {
+        return Err(LogError::TooLarge { path: path.clone(), limit: max_bytes, compressed: true });
+    }
+    // No record inside a compressed chunk is longer than the chunk declares: the crate reserves what a
+    // record's length claims before it decompresses the record.
+    let limit = if compressed { declared.max(chunk.len() as u64) } else { MAX_RECORD_BYTES as u64 };
     let options = LinearReaderOptions::default()
         .with_skip_start_magic(true)
         .with_skip_end_magic(true)
         .with_prevalidate_chunk_crcs(true)
-        .with_record_length_limit(MAX_RECORD_BYTES);
+        .with_record_length_limit(usize::try_from(limit).unwrap_or(MAX_RECORD_BYTES).min(MAX_RECORD_BYTES));
     let mut reader = LinearReader::new_with_options(options);
     let mut input = Some(chunk);
     while let Some(event) = reader.next_event() {
@@ -203,27 +227,63 @@ fn read_chunk(at: u64, body: &[u8], records: &mut Records) -> Result<(), LogErro
                 )));
             }
             Err(mcap::McapError::UnexpectedEof) => return Err(err("its records run past its end")),
+            Err(mcap::McapError::RecordTooLarge { opcode, len }) if compressed => {
+                return Err(err(&format!(
+                    "a record (opcode {opcode:#04x}) claims {len} bytes, more than the chunk declares ({declared} \
+                     bytes uncompressed)"
+                )));
+            }
             Err(e) => return Err(mcap_err(&path, Place::Chunk(at), e)),
         }
     }
     Ok(())
 }
 
-/// The uncompressed size a chunk record's `body` declares, whether the chunk is compressed, and its header
-/// and records (without any bytes after them in the record); `None` if they run past the record.
-fn chunk_parts(body: &[u8]) -> Option<(u64, bool, &[u8])> {
+/// The most bytes one byte of `compression`'s output can decompress to, when the codec bounds it (`None`:
+/// uncompressed, or a compression the crate does not read, which it refuses before allocating).
+///
+/// zstd: a block decompresses to at most 128 KiB (its `Block_Maximum_Size`) and takes at least 4 bytes (a
+/// 3-byte block header and an RLE block's one byte), so at most 32768 times. lz4: a sequence that repeats a
+/// match of `L` bytes takes a token, a 2-byte offset and one length byte per 255 bytes of `L` past 19, so
+/// fewer than 255 times.
+fn max_expansion(compression: &str) -> Option<u64> {
+    match compression {
+        "zstd" => Some(32_768),
+        "lz4" => Some(255),
+        _ => None,
+    }
+}
+
+/// A chunk record's parts.
+struct ChunkParts<'a> {
+    /// The uncompressed size the chunk declares.
+    declared: u64,
+    /// Its compression's name (empty: uncompressed).
+    compression: &'a str,
+    /// The length of its (compressed) records.
+    compressed_bytes: u64,
+    /// Its header and records, without any bytes after them in the record.
+    chunk: &'a [u8],
+}
+
+/// The parts of a chunk record's `body`; `None` if they run past the record.
+fn chunk_parts(body: &[u8]) -> Option<ChunkParts<'_>> {
     let mut f = Fields(body);
     // Start and end time, uncompressed size, CRC, compression, the records' length.
     f.u64()?;
     f.u64()?;
     let declared = f.u64()?;
-    let compression = f.skip(4).then(|| f.len()).flatten()?;
+    let name_len = f.skip(4).then(|| f.len()).flatten()?;
+    let name = f.0.get(4..)?.get(..name_len)?;
     if !f.prefixed() {
         return None;
     }
-    let records = usize::try_from(f.u64()?).ok()?;
+    let compressed_bytes = f.u64()?;
+    let records = usize::try_from(compressed_bytes).ok()?;
     let end = (body.len() - f.0.len()).checked_add(records)?;
-    Some((declared, compression > 0, body.get(..end)?))
+    // A compression name that is not UTF-8 names no codec: the crate refuses it.
+    let compression = std::str::from_utf8(name).unwrap_or("?");
+    Some(ChunkParts { declared, compression, compressed_bytes, chunk: body.get(..end)? })
 }
 
 /// Whether the length-prefixed fields of a schema, channel or chunk index record (strings, maps, the

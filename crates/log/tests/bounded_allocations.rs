@@ -57,6 +57,28 @@ fn claims(n: u32, real: &[u8]) -> Vec<u8> {
     [&n.to_le_bytes()[..], real].concat()
 }
 
+/// An MCAP chunk record compressed as `compression` says, declaring `declared` bytes uncompressed (CRC
+/// `crc`), holding `records` as its compressed data.
+fn mcap_chunk(compression: &str, declared: u64, crc: u32, records: &[u8]) -> Vec<u8> {
+    let body = [
+        &[0u8; 16][..],
+        &declared.to_le_bytes(),
+        &crc.to_le_bytes(),
+        &(compression.len() as u32).to_le_bytes(),
+        compression.as_bytes(),
+        &(records.len() as u64).to_le_bytes(),
+        records,
+    ];
+    mcap_record(0x06, &body.concat())
+}
+
+/// A zstd frame holding `content` as one raw block (single segment, its size in one byte, no checksum).
+fn zstd_raw(content: &[u8]) -> Vec<u8> {
+    let n = u8::try_from(content.len()).unwrap();
+    let block = (u32::from(n) << 3 | 1).to_le_bytes();
+    [&[0x28, 0xb5, 0x2f, 0xfd, 0x20, n][..], &block[..3], content].concat()
+}
+
 #[test]
 fn small_files_claiming_large_fields_allocate_little() {
     let huge = 0xFFFF_FFF0;
@@ -72,6 +94,20 @@ fn small_files_claiming_large_fields_allocate_little() {
         (
             "chunk.mcap",
             [MCAP_MAGIC, &mcap_record(0x06, &[&[0u8; 28][..], &claims(huge, b"zstd"), &[0; 16]].concat())].concat(),
+        ),
+        // Compressed chunks of 64 bytes declaring 1 GiB uncompressed: the `mcap` crate reserves what a chunk
+        // declares before it decompresses.
+        ("zstd_chunk.mcap", [MCAP_MAGIC, &mcap_chunk("zstd", (1 << 30) - 1, 1, &[0x5a; 64])].concat()),
+        ("lz4_chunk.mcap", [MCAP_MAGIC, &mcap_chunk("lz4", (1 << 30) - 1, 1, &[0x5a; 64])].concat()),
+        // A zstd chunk of 9 bytes uncompressed holding a message record that claims 1 GiB: the crate reserves
+        // what a record inside a chunk claims before it decompresses the record.
+        (
+            "zstd_record.mcap",
+            [
+                MCAP_MAGIC,
+                &mcap_chunk("zstd", 9, 0, &zstd_raw(&[&[0x05][..], &((1u64 << 30) - 1).to_le_bytes()].concat())),
+            ]
+            .concat(),
         ),
         // A ROS 1 record whose header claims 1 GiB.
         ("record.bag", [&b"#ROSBAG V2.0\n"[..], &claims((1 << 30) - 1, b"op=\x03")].concat()),
