@@ -6,16 +6,14 @@ use super::outputs::{Outputs, kind};
 use super::run_bag::RunBag;
 use anyhow::{Context, Result, bail};
 use clap::Args;
+use mrslam_core::Odometry;
 use mrslam_core::output::{AtomicFile, write_file_atomic};
-use mrslam_core::pose::interpolate;
 use mrslam_core::relations::{StampedPose, format_relations, format_trajectory};
 use mrslam_core::truth_relations::{TruthRelations, relations_from_truth};
-use mrslam_core::{Odometry, Pose2};
 use mrslam_log::carmen_writer::CarmenWriter;
-use mrslam_testbed::runner::{RobotStep, RunOptions, run as run_scenario};
+use mrslam_testbed::runner::{PoseHistory, RobotStep, RunOptions, run as run_scenario};
 use mrslam_testbed::scenario::Scenario;
 use serde_json::json;
-use std::collections::VecDeque;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -57,25 +55,8 @@ struct RobotLog {
     truth: Vec<StampedPose>,
     beams: usize,
     range_max: f32,
-    /// (time, true pose, odometry pose) at the ends of the last steps, oldest first.
-    history: VecDeque<(f64, Pose2, Pose2)>,
-}
-
-/// Steps of history kept: more than a scan period of the slowest lidar.
-const HISTORY: usize = 400;
-
-/// The true pose and odometry pose at `stamp`, interpolated between the steps that bracket it (the nearest
-/// end of the history outside it).
-fn at_stamp(history: &VecDeque<(f64, Pose2, Pose2)>, stamp: f64) -> Option<(Pose2, Pose2)> {
-    let k = history.partition_point(|h| h.0 < stamp);
-    let (a, b) = match (k.checked_sub(1).and_then(|i| history.get(i)), history.get(k)) {
-        (Some(a), Some(b)) => (a, b),
-        (Some(a), None) => (a, a),
-        (None, Some(b)) => (b, b),
-        (None, None) => return None,
-    };
-    let s = if b.0 > a.0 { ((stamp - a.0) / (b.0 - a.0)).clamp(0.0, 1.0) } else { 0.0 };
-    Some((interpolate(&a.1, &b.1, s), interpolate(&a.2, &b.2, s)))
+    /// The robot's recent true and odometry poses.
+    history: PoseHistory,
 }
 
 /// The files `mrslam sim log` writes for robot `name` in `dir`.
@@ -132,7 +113,7 @@ pub fn run(args: LogArgs) -> Result<ExitCode> {
             truth: Vec::new(),
             beams: 0,
             range_max: 0.0,
-            history: VecDeque::new(),
+            history: PoseHistory::default(),
         });
     }
     let bar = super::sim_progress::bar(&scenario.name, scenario.duration, args.quiet);
@@ -146,14 +127,10 @@ pub fn run(args: LogArgs) -> Result<ExitCode> {
             return;
         }
         let log = &mut logs[s.robot];
-        log.history.push_back((s.time, *s.true_pose, s.odometry.pose));
-        if log.history.len() > HISTORY {
-            log.history.pop_front();
-        }
+        log.history.push(s.time, *s.true_pose, s.odometry.pose);
         for scan in s.scans {
             // The scan was taken from its stamp on, up to a scan period before this step's end.
-            let (true_pose, odometry_pose) =
-                at_stamp(&log.history, scan.stamp).unwrap_or((*s.true_pose, s.odometry.pose));
+            let (true_pose, odometry_pose) = log.history.at(scan.stamp).unwrap_or((*s.true_pose, s.odometry.pose));
             let odometry = Odometry { stamp: scan.stamp, pose: odometry_pose };
             let written = (|| {
                 if odom_lines {

@@ -154,6 +154,10 @@ impl PurePursuit {
 /// free cells next to unknown ones; reachability is a breadth-first search over free cells at least
 /// `clearance` from any occupied cell (see [`crate::frontier`]). A team planner may instead hand it the path
 /// to follow ([`Self::follow`]) or tell it that nothing is left ([`Self::finish`]).
+///
+/// When no frontier is reachable it first turns once on the spot, as a navigation stack's rotate recovery
+/// does: a lidar that sees less than a full circle, or a map whose specks close the way, may open up; only a
+/// plan that fails again after the turn ends the exploration.
 #[derive(Debug, Clone)]
 pub struct Explorer {
     /// Distance kept from walls when planning, metres.
@@ -167,6 +171,10 @@ pub struct Explorer {
     finished: bool,
     blocked_s: f64,
     abandoned: Vec<Point2<f64>>,
+    /// Radians left of the turn on the spot in progress.
+    turn_left: f64,
+    /// True once it has turned since its last successful plan.
+    turned: bool,
 }
 
 /// True when a beam of `scan` (taken by a lidar at `mount` on the robot) ends in the corridor the robot is
@@ -191,6 +199,8 @@ impl Explorer {
     pub const MARGIN: f64 = 0.2;
     /// Look-ahead of the path follower, metres (shorter than the scripted routes': frontier paths bend).
     pub const LOOKAHEAD: f64 = 0.35;
+    /// Turn rate of the turn on the spot when no frontier is reachable, rad/s.
+    pub const TURN_RATE: f64 = 0.5;
 
     /// An explorer driving at `speed`, keeping `clearance` from walls.
     pub fn new(speed: f64, clearance: f64) -> Self {
@@ -203,6 +213,8 @@ impl Explorer {
             finished: false,
             blocked_s: 0.0,
             abandoned: Vec::new(),
+            turn_left: 0.0,
+            turned: false,
         }
     }
 
@@ -214,15 +226,30 @@ impl Explorer {
     /// True when the explorer wants a fresh map to plan on.
     pub fn wants_plan(&self) -> bool {
         !self.finished
+            && self.turn_left <= 0.0
             && (self.since_plan >= self.replan_period || self.follower.as_ref().is_none_or(PurePursuit::is_done))
     }
 
-    /// Plans a path to the nearest frontier on `map` from `pose` (both in the SLAM frame).
+    /// Plans a path to the nearest frontier on `map` from `pose` (both in the SLAM frame); without one, turns
+    /// once on the spot, then gives up.
     pub fn plan(&mut self, map: &OccupancyGrid, pose: &Pose2) {
         match frontier_path(map, pose, self.clearance, &self.abandoned, Self::ABANDONED_RADIUS) {
-            Some(path) => self.follow(path),
+            Some(path) => {
+                self.turned = false;
+                self.follow(path);
+            }
+            None if !self.turned => {
+                self.follower = None;
+                self.turned = true;
+                self.turn_left = std::f64::consts::TAU;
+            }
             None => self.finish(),
         }
+    }
+
+    /// True while it turns on the spot to look for a frontier.
+    pub fn is_turning(&self) -> bool {
+        self.turn_left > 0.0
     }
 
     /// Follows `path` (the frame of the pose later given to [`Self::command`]) from now on, replacing the goal
@@ -230,6 +257,7 @@ impl Explorer {
     pub fn follow(&mut self, path: Vec<Point2<f64>>) {
         self.since_plan = 0.0;
         self.finished = false;
+        self.turn_left = 0.0;
         let mut f = PurePursuit::new(path, self.speed);
         f.lookahead = Self::LOOKAHEAD;
         self.follower = Some(f);
@@ -239,6 +267,7 @@ impl Explorer {
     pub fn finish(&mut self) {
         self.since_plan = 0.0;
         self.follower = None;
+        self.turn_left = 0.0;
         self.finished = true;
     }
 
@@ -259,6 +288,10 @@ impl Explorer {
     /// goal, as an exploration stack abandons a goal it cannot reach, and plans to another frontier.
     pub fn command(&mut self, pose: &Pose2, dt: f64, blocked: bool) -> (f64, f64) {
         self.since_plan += dt;
+        if self.turn_left > 0.0 {
+            self.turn_left -= Self::TURN_RATE * dt;
+            return (0.0, Self::TURN_RATE);
+        }
         let Some(f) = &mut self.follower else { return (0.0, 0.0) };
         let (v, w) = f.command(pose, dt);
         if !(blocked && v > 0.0) {
@@ -361,6 +394,34 @@ mod tests {
         e.plan(&g, &start);
         let second = e.follower.as_ref().and_then(PurePursuit::goal).unwrap();
         assert!(second.x < 0.5, "then the west one: {second:?}");
+    }
+
+    #[test]
+    fn a_robot_with_no_reachable_frontier_turns_once_on_the_spot_before_it_gives_up() {
+        // A closed, fully known room: nothing to explore.
+        let mut g = OccupancyGrid::new(40, 40, 0.05, pose(0.0, 0.0, 0.0)).unwrap();
+        for iy in 0..40 {
+            for ix in 0..40 {
+                let wall = ix == 0 || iy == 0 || ix == 39 || iy == 39;
+                g.set(ix, iy, if wall { 2.0 } else { -2.0 });
+            }
+        }
+        let start = pose(1.0, 1.0, 0.0);
+        let mut e = Explorer::new(0.3, 0.2);
+        e.plan(&g, &start);
+        assert!(e.is_turning() && !e.is_done() && !e.wants_plan());
+        let dt = 0.1;
+        let mut turned = 0.0;
+        while e.is_turning() {
+            let (v, w) = e.command(&start, dt, false);
+            assert_eq!(v, 0.0, "it turns on the spot");
+            turned += w * dt;
+            assert!(turned < 7.0, "the turn ends");
+        }
+        assert!((turned - std::f64::consts::TAU).abs() <= Explorer::TURN_RATE * dt + 1e-9, "one full turn: {turned}");
+        assert!(e.wants_plan(), "then it plans again");
+        e.plan(&g, &start);
+        assert!(e.is_done(), "still nothing after the turn: done");
     }
 
     #[test]

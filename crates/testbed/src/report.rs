@@ -185,13 +185,23 @@ pub struct MergeAttempt {
     pub known_m2: [f64; 2],
     /// Passed the merger's gate: the teams joined.
     pub accepted: bool,
-    /// Accepted and within the scenario's success thresholds of the true transform; `false` when accepted
-    /// outside them (a false merge: the teams joined on a wrong transform) or refused.
+    /// Accepted and within the scenario's success thresholds of the true transform where the two robots meet
+    /// (`*_at_contact`); `false` when accepted outside them (a false merge: the teams joined on a wrong
+    /// transform) or refused.
     pub correct: bool,
-    /// Rotation error of the merger's transform against the truth, degrees (null without a transform).
+    /// Rotation error of the merger's transform against the truth of the two teams' frames (their roots'
+    /// start poses), degrees (null without a transform): the merger's error plus both maps' drift since then.
     pub rotation_error_deg: Option<f64>,
-    /// Translation error, metres.
+    /// Translation error against the same, metres.
     pub translation_error_m: Option<f64>,
+    /// Rotation error against the two maps' relative transform as the two robots' current poses place them
+    /// (each map put in the world so that its robot's SLAM pose is the true one), degrees: the merger's own
+    /// error where the maps meet, without the drift the maps carry from their starts.
+    #[serde(default)]
+    pub rotation_error_at_contact_deg: Option<f64>,
+    /// Translation error against that same transform at the other robot's position, metres.
+    #[serde(default)]
+    pub translation_error_at_contact_m: Option<f64>,
     /// The cascade's deciding stage.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub stage: Option<String>,

@@ -2,10 +2,11 @@
 //! evaluation needs of its drive.
 
 use super::options::RunError;
+use super::pose_history::PoseHistory;
 use crate::controller::{Controller, Explorer, PurePursuit, blocked_ahead};
 use crate::scenario::{ControllerKind, RobotSetup, Scenario};
 use mrslam_core::{CellTraversal, LaserScan, OccupancyGrid, Odometry, Pose2};
-use mrslam_sim::{RobotId, Sim};
+use mrslam_sim::{LidarModel, RobotId, Sim};
 use mrslam_slam::{Rbpf, SlamBackend};
 use nalgebra::Point2;
 use std::time::Instant;
@@ -20,12 +21,16 @@ pub(super) struct Agent<'s> {
     /// The robot's SLAM. A trait object: each robot of a scenario may run its own back-end.
     pub slam: Box<dyn SlamBackend>,
     pub controller: Controller,
+    /// The robot's recent true and odometry poses, to pair each scan with the instant it was taken.
+    pub history: PoseHistory,
     /// The latest scan, for the explorer's look ahead.
     pub last_scan: Option<LaserScan>,
     /// (truth, odometry) at each processed scan, in the world and odometry frames.
     pub processed: Vec<(Pose2, Pose2)>,
     /// The odometry pose of the last reading fed to SLAM (its best pose is the robot's there).
     pub fed_odometry: Option<Pose2>,
+    /// The true pose of the last reading fed to SLAM.
+    pub fed_truth: Option<Pose2>,
     pub scans: usize,
     pub distance: f64,
     pub last: Pose2,
@@ -67,6 +72,12 @@ impl Agent<'_> {
         self.controller.is_done()
     }
 
+    /// Where the robot's current SLAM pose puts its map frame in the world (the map's pose that makes the SLAM
+    /// pose the true one): the map as seen from where the robot is now, its drift since its start left out.
+    pub fn frame_here(&self) -> Option<Pose2> {
+        self.fed_truth.map(|truth| truth * self.slam.best_pose().inverse())
+    }
+
     /// Where the robot's SLAM puts its odometry frame in its map (ROS's `map -> odom`): its best pose times
     /// the inverse of the odometry pose it was fed last; `None` before its first reading.
     pub fn map_to_odom(&self) -> Option<Pose2> {
@@ -104,6 +115,14 @@ impl Agent<'_> {
         }
     }
 
+    /// A scan just delivered, with the odometry and true pose of the instant it was taken (see
+    /// [`pairing_time`]), as a real robot's SLAM looks its odometry up at the scan's stamp.
+    pub fn reading(&self, scan: LaserScan) -> Reading {
+        let time = pairing_time(&self.setup.lidar, &scan);
+        let (true_pose, odometry) = self.history.at(time).expect("the history holds the step that delivered the scan");
+        (scan, Odometry { stamp: time, pose: odometry }, true_pose)
+    }
+
     /// Feeds the scans of this step to SLAM, recording truth and odometry for evaluation.
     pub fn process(&mut self, scans: Vec<Reading>, truth: &OccupancyGrid) -> Result<(), RunError> {
         for (scan, odom, true_pose) in scans {
@@ -113,12 +132,24 @@ impl Agent<'_> {
             let outcome = self.slam.process(&odom, &scan).map_err(|error| self.slam_error(error))?;
             self.slam_s += t.elapsed().as_secs_f64();
             self.fed_odometry = Some(odom.pose);
+            self.fed_truth = Some(true_pose);
             if outcome.is_processed() {
                 self.processed.push((true_pose, odom.pose));
             }
             self.last_scan = Some(scan);
         }
         Ok(())
+    }
+}
+
+/// The instant a scan's odometry is looked up at: its stamp (its first beam) for a scanner that sweeps too fast
+/// to skew (SICK, Hokuyo); for one that sweeps while the robot moves (RPLidar), the middle beam's time, which
+/// halves the worst beam's skew.
+pub(super) fn pairing_time(lidar: &LidarModel, scan: &LaserScan) -> f64 {
+    if lidar.skew {
+        scan.stamp + 0.5 * scan.len().saturating_sub(1) as f64 * lidar.time_increment()
+    } else {
+        scan.stamp
     }
 }
 
@@ -173,9 +204,11 @@ pub(super) fn add_robots<'s>(
             id,
             slam: Box::new(slam),
             controller,
+            history: PoseHistory::default(),
             last_scan: None,
             processed: Vec::new(),
             fed_odometry: None,
+            fed_truth: None,
             scans: 0,
             distance: 0.0,
             last: r.start,

@@ -50,6 +50,9 @@ pub(super) fn drive(
         }
         for a in agents.iter_mut() {
             let true_pose = sim.true_pose(a.id)?;
+            if a.history.is_empty() {
+                a.history.push(t, true_pose, sim.odometry(a.id)?.pose);
+            }
             let (v, w) = a.command(&true_pose, dt)?;
             sim.set_velocity_command(a.id, v, w)?;
         }
@@ -61,9 +64,11 @@ pub(super) fn drive(
             let pose = sim.true_pose(a.id)?;
             a.distance += (pose.translation.vector - a.last.translation.vector).norm();
             a.last = pose;
+            let odometry = sim.odometry(a.id)?;
+            a.history.push(sim.time(), pose, odometry.pose);
             let mut batch = Vec::new();
             while let Some(scan) = sim.take_scan(a.id)? {
-                batch.push((scan, sim.odometry(a.id)?, pose));
+                batch.push(a.reading(scan));
             }
             batches.push(batch);
         }

@@ -13,11 +13,13 @@ mod evaluate;
 mod merge;
 mod options;
 mod outputs;
+mod pose_history;
 mod record;
 mod team;
 
 pub use options::{RobotStep, RunError, RunOptions, RunOutput, StepTap};
 pub use outputs::{merge_overlay, output_files, write_outputs};
+pub use pose_history::PoseHistory;
 pub use record::merge_view;
 
 use crate::report::RunReport;

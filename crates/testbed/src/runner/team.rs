@@ -246,8 +246,19 @@ impl<'s> Teams<'s> {
             let (fa, fb) = (frames[ra].unwrap_or_default(), frames[rb].unwrap_or_default());
             let true_t = fa.inv_mul(&fb);
             let err = out.report.transform.map(|x| transform_error(&x.to_pose(), &true_t));
+            // Each team's frame as its robot in contact places it: that robot's map frame where its pose is
+            // true, times where the team's map puts that robot's frame.
+            let here = |k: usize| agents[k].frame_here().map(|f| f * self.place[k].inverse());
+            let contact_t = here(host).zip(here(other)).map(|(fa, fb)| fa.inv_mul(&fb));
+            // Measured at the other robot, where the two maps meet, rather than at its team frame's origin.
+            let at_other = self.place[other] * agents[other].slam.best_pose();
+            let err_here = out
+                .report
+                .transform
+                .zip(contact_t)
+                .map(|(x, t)| transform_error(&(x.to_pose() * at_other), &(t * at_other)));
             let correct = out.report.accepted
-                && err.is_some_and(|(r, d)| {
+                && err_here.is_some_and(|(r, d)| {
                     r.to_degrees() <= self.success.rotation_deg && d <= self.success.translation_m
                 });
             let name = |k: usize| agents[k].setup.name.clone();
@@ -261,6 +272,8 @@ impl<'s> Teams<'s> {
                 correct,
                 rotation_error_deg: err.map(|e| e.0.to_degrees()),
                 translation_error_m: err.map(|e| e.1),
+                rotation_error_at_contact_deg: err_here.map(|e| e.0.to_degrees()),
+                translation_error_at_contact_m: err_here.map(|e| e.1),
                 stage: out.report.stage.clone(),
                 reason: out.report.reason.clone(),
                 time_ms: out.report.time_ms,

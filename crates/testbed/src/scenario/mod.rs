@@ -268,7 +268,7 @@ mod tests {
 
     #[test]
     fn a_robots_slam_table_picks_a_preset_sets_parameters_by_name_and_the_lidar_caps_the_range() {
-        // Without a table: the preset that matches the lidar's reach (Hokuyo 4 m, RpLidar 6 m).
+        // Without a table: the preset that matches the lidar's reach (Hokuyo 4 m, RpLidar 6 m, SICK 80 m).
         let s = two_rooms(|t| t).unwrap();
         assert_eq!(s.robots[0].slam, {
             let mut p = SlamParams::hokuyo();
@@ -277,6 +277,10 @@ mod tests {
             p
         });
         assert!(!s.robots[1].slam.scan_odometry.enabled);
+        // A SICK-class 80 m lidar: `slam`'s default for real logs, whose robots carry such lidars.
+        let s = two_rooms(|t| t.replace("lidar = \"rplidar_a1\"", "lidar = \"sick_lms\"")).unwrap();
+        assert_eq!(s.robots[1].lidar.range_max, 80.0);
+        assert!(s.robots[1].slam.scan_odometry.enabled, "the matched preset");
         // A preset and parameters by name; the 80 m preset is capped at the robot's lidar.
         let table =
             "slam = { preset = \"matched\", particles = 12, scan_odometry_reach = 2, linear_update = \"0.4\" }\n";

@@ -212,9 +212,11 @@ fn resolve_lidar(cx: &Ctx, field: &str, r: &LidarRef) -> Result<LidarModel, Scen
 fn resolve_slam(cx: &Ctx, field: &str, s: &SlamFile, lidar: &LidarModel) -> Result<SlamParams, ScenarioError> {
     let mut p = match s.preset.as_deref() {
         Some(name) => name.parse::<mrslam_slam::Preset>().map_err(|e| cx.err(field, e))?.params(),
-        // Without a preset, the one matching the lidar's reach.
+        // Without a preset, the one made for a lidar of this reach: the simulated Hokuyo (4 m) and RpLidar
+        // (6-12 m) robots' presets, and for longer-range scanners (SICK class) `slam`'s default for real logs.
         None if lidar.range_max <= 4.5 => SlamParams::hokuyo(),
-        None => SlamParams::rplidar(),
+        None if lidar.range_max <= 12.0 => SlamParams::rplidar(),
+        None => SlamParams::matched(),
     };
     // Each name sets its own field, so the (sorted) order of application does not matter.
     for (name, value) in &s.params {
