@@ -2,7 +2,7 @@
 # The SLAM goal table: `mrslam slam` with the CLI's defaults (or PRESET) and only --seed changed, on the three
 # benchmark logs of ../shared/data/logs, seeds 0-4; one JSON summary per run in OUT, then a Markdown table.
 #   dev/scripts/slam_seeds.sh OUT [PRESET] [LOGS...]
-# Run from the repository after `cargo build --release`; one run at a time, so the real-time factors are of an
+# Run from the repository after `cargo build --release` (or with MRSLAM=path/to/mrslam); one run at a time, so the real-time factors are of an
 # otherwise idle machine.
 set -euo pipefail
 out=${1:?usage: slam_seeds.sh OUT [PRESET] [LOGS...]}
@@ -16,7 +16,7 @@ for log in "${logs[@]}"; do
   for seed in 0 1 2 3 4; do
     s="$out/$log-$preset-seed$seed"
     [ -f "$s.json" ] && continue
-    ./target/release/mrslam slam "$data/$log.clf.gz" --preset "$preset" --seed "$seed" -o "$s.yaml" \
+    "${MRSLAM:-./target/release/mrslam}" slam "$data/$log.clf.gz" --preset "$preset" --seed "$seed" -o "$s.yaml" \
       --relations "$data/$log.relations" --summary "$s.json" --quiet > "$s.txt"
   done
 done

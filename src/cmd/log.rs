@@ -10,7 +10,8 @@ use std::process::ExitCode;
 #[derive(Args, Debug, Clone)]
 pub struct ReadArgs {
     /// Each scan's odometry: `interpolated` (ODOM lines interpolated at the scan's stamp where they bracket
-    /// it, else the scan line's own fields) or `line` (the scan line's own odometry fields, as GMapping).
+    /// it, else the scan line's own fields; the own fields everywhere when the ODOM lines are stamped in bursts)
+    /// or `line` (the scan line's own odometry fields, as GMapping).
     #[arg(long, default_value_t = OdometrySource::Interpolated)]
     pub odometry: OdometrySource,
     /// Refuse a log whose sensor stamps step back by more than this many seconds (real logs interleave
@@ -131,10 +132,15 @@ pub fn run(cmd: LogCommand) -> Result<ExitCode> {
             }
             match &parsed.bag {
                 Some(bag) => println!(
-                    "odometry:  {} readings from {}, interpolated at {} scans' stamps",
+                    "odometry:  {} readings from {}, interpolated at {} scans' stamps{}",
                     parsed.odometry.len(),
                     bag.odometry,
-                    parsed.repairs.interpolated_odometry
+                    parsed.repairs.interpolated_odometry,
+                    if parsed.repairs.stamped_in_bursts {
+                        "; stamped in bursts, so each scan holds the reading before it"
+                    } else {
+                        ""
+                    }
                 ),
                 None => println!(
                     "odometry:  {} ODOM lines; scans use {}",

@@ -12,6 +12,7 @@ use mrslam_core::map_io;
 use mrslam_core::output::write_file_atomic;
 use mrslam_core::relations::{self, StampedPose};
 use mrslam_core::{Odometry, Pose2};
+use mrslam_log::repair::{MAX_SPEED, MAX_TURN_RATE, faster_than_a_robot};
 use mrslam_slam::synthetic::{Drift, inject_drift};
 use mrslam_slam::{LogRun, LogRunError, Preset, Rbpf, map_log};
 use mrslam_viz::{Level, ProcessedScan, RelationMark, SlamLogRecorder};
@@ -406,6 +407,8 @@ pub fn run(args: SlamArgs) -> Result<ExitCode> {
                 "reversed_increments": r.reversed_increments,
                 "interpolated_odometry": r.interpolated_odometry,
                 "line_odometry": r.line_odometry,
+                "burst_odometry_increments": r.burst_increments,
+                "odometry_stamped_in_bursts": r.stamped_in_bursts,
             },
             "odometry_jumps": jumps.len(),
             "scan_odometry": filter.params().scan_odometry.enabled.then(|| {
@@ -493,11 +496,6 @@ fn record_the_end(
     Ok(())
 }
 
-/// Odometry faster than this between two scans is a jump (a kidnapped robot or a reset), m/s.
-const MAX_SPEED: f64 = 5.0;
-/// Odometry turning faster than this between two scans is a jump, rad/s.
-const MAX_TURN_RATE: f64 = 10.0;
-
 /// An odometry jump between two consecutive scans.
 struct OdometryJump {
     /// Where the later scan is in the log.
@@ -510,16 +508,15 @@ struct OdometryJump {
     seconds: f64,
 }
 
-/// The increments between consecutive scans' odometry that no robot drives: faster than [`MAX_SPEED`] or
-/// [`MAX_TURN_RATE`] (over at least 0.1 s, so that stamp jitter does not make a slow move look fast).
+/// The increments between consecutive scans' odometry that no robot drives ([`faster_than_a_robot`], over at
+/// least 0.1 s, so that stamp jitter does not make a slow move look fast): a kidnapped robot or a reset.
 fn odometry_jumps(odometry: &[Odometry], scans: &[mrslam_log::ScanRecord]) -> Vec<OdometryJump> {
     let mut jumps = Vec::new();
     for (k, w) in odometry.windows(2).enumerate() {
         let step = w[0].pose.inv_mul(&w[1].pose);
         let (distance, turn) = (step.translation.vector.norm(), step.rotation.angle().abs());
         let seconds = w[1].stamp - w[0].stamp;
-        let span = seconds.max(0.1);
-        if distance > MAX_SPEED * span || turn > MAX_TURN_RATE * span {
+        if faster_than_a_robot(&w[0].pose, &w[1].pose, seconds.max(0.1)) {
             jumps.push(OdometryJump { at: scans[k + 1].source.clone(), distance, turn, seconds });
         }
     }

@@ -193,9 +193,11 @@ pub(crate) fn assemble(bag: BagMessages, options: &ReadOptions, format: String) 
     }
     order.finish(&mut log);
 
-    // A scan outside the odometry's span holds the nearest reading, as a CARMEN scan line's own odometry
-    // fields hold the last reading received, when it is no further from it than the longest interval
-    // between two readings; farther scans are dropped, counted.
+    // A scan holds the last reading at or before its stamp, as a CARMEN scan line's own odometry fields hold
+    // the last reading received (the repairs below interpolate the stream instead wherever its readings
+    // bracket the scan and are not stamped in a burst); before the first reading, the first, when it is no
+    // further from it than the longest interval between two readings; scans farther outside the span are
+    // dropped, counted.
     let mut stamps: Vec<(f64, Pose2)> =
         readings.iter().map(|r| (r.record.odometry.stamp, r.record.odometry.pose)).collect();
     stamps.sort_by(|a, b| a.0.total_cmp(&b.0));
@@ -203,13 +205,12 @@ pub(crate) fn assemble(bag: BagMessages, options: &ReadOptions, format: String) 
     let held = |t: f64| match (stamps.first(), stamps.last()) {
         (Some(first), _) if t < first.0 => (first.0 - t <= longest).then_some(first.1),
         (_, Some(last)) if t > last.0 => (t - last.0 <= longest).then_some(last.1),
-        (Some(_), Some(_)) => Some(Pose2::identity()),
+        (Some(_), Some(_)) => Some(stamps[stamps.partition_point(|r| r.0 <= t).max(1) - 1].1),
         _ => None,
     };
     let mut outside = 0;
     for a in scans {
         let s = &a.msg;
-        // Inside the span the repairs below interpolate the odometry stream at the scan's stamp.
         let Some(pose) = held(s.stamp - options.scan_latency) else {
             outside += 1;
             continue;

@@ -4,8 +4,9 @@
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum OdometrySource {
     /// The odometry stream interpolated at the scan's stamp where two readings bracket it; the scan's own
-    /// odometry elsewhere (and in logs without an odometry stream). The default: a CARMEN scan line's
-    /// odometry fields hold whichever ODOM message arrived last, up to one odometry period away from the scan.
+    /// odometry elsewhere (and in logs without an odometry stream), and everywhere when the stream is stamped
+    /// in bursts (see [`crate::repair::odometry_at_scans`]). The default: a CARMEN scan line's odometry fields
+    /// hold whichever ODOM message arrived last, up to one odometry period away from the scan.
     #[default]
     Interpolated,
     /// The odometry logged with the scan itself (CARMEN: FLASER/RLASER `odom_*`, ROBOTLASER1 robot pose), as

@@ -78,6 +78,11 @@ pub struct Repairs {
     pub interpolated_odometry: usize,
     /// Scans whose odometry is their own record's.
     pub line_odometry: usize,
+    /// Increments of the odometry stream faster than a robot moves ([`crate::repair::faster_than_a_robot`]).
+    pub burst_increments: usize,
+    /// Whether so many are ([`crate::repair::MAX_BURST_SHARE`]) that the stream is stamped in bursts, not when
+    /// measured, and the scans kept their own odometry ([`crate::repair::odometry_at_scans`]).
+    pub stamped_in_bursts: bool,
 }
 
 impl Repairs {
@@ -113,10 +118,21 @@ impl Repairs {
 
     /// One line saying where the scans' odometry came from.
     pub fn describe_odometry(&self) -> String {
-        match (self.interpolated_odometry, self.line_odometry) {
+        let text = match (self.interpolated_odometry, self.line_odometry) {
             (0, n) => format!("the scan lines' own odometry fields ({n} scans)"),
             (n, 0) => format!("ODOM lines interpolated at every scan's stamp ({n} scans)"),
             (n, m) => format!("ODOM lines interpolated at {n} scans' stamps, the scan line's own fields at {m}"),
+        };
+        if self.stamped_in_bursts {
+            format!(
+                "{text}: the odometry stream is stamped in bursts ({} of its increments faster than {} m/s or {} \
+                 rad/s), its stamps are not when it was measured",
+                self.burst_increments,
+                crate::repair::MAX_SPEED,
+                crate::repair::MAX_TURN_RATE
+            )
+        } else {
+            text
         }
     }
 }
