@@ -9,8 +9,8 @@
 use crate::options::{OdometrySource, ReadOptions};
 use crate::sensor_log::{OdometryRecord, ScanRecord, SensorLog};
 use crate::source::Source;
-use mrslam_core::{Odometry, Pose2};
 use mrslam_core::pose::interpolate;
+use mrslam_core::{Odometry, Pose2};
 
 /// Fastest a robot drives, m/s: odometry readings whose stamps imply more were not stamped when they were
 /// measured (a logger that stamps a buffered burst on arrival), or the robot was carried or reset.
@@ -374,9 +374,8 @@ mod tests {
     fn a_stream_stamped_in_bursts_is_not_interpolated() {
         // 0.1 m every 0.1 s (1 m/s), then stamped in bursts: ten readings within a millisecond each 0.1 s.
         let steady: Vec<OdometryRecord> = (0..200).map(|k| odom(k as f64 * 0.1, k as f64 * 0.1, 0.0)).collect();
-        let burst: Vec<OdometryRecord> = (0..200)
-            .map(|k| odom((k / 10) as f64 * 0.1 + (k % 10) as f64 * 1e-4, k as f64 * 0.1, 0.0))
-            .collect();
+        let burst: Vec<OdometryRecord> =
+            (0..200).map(|k| odom((k / 10) as f64 * 0.1 + (k % 10) as f64 * 1e-4, k as f64 * 0.1, 0.0)).collect();
         let scans = vec![scan(5.05, "A", &[1.0], 1)];
         let mut good = SensorLog { scans: scans.clone(), odometry: steady.clone(), ..SensorLog::default() };
         odometry_at_scans(&mut good, OdometrySource::Interpolated, 0.0);
