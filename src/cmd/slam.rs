@@ -345,8 +345,12 @@ pub fn run(args: SlamArgs) -> Result<ExitCode> {
         filter.params().filter.particles
     );
     if filter.params().scan_odometry.enabled {
-        let (matched, dead) = filter.scan_odometry_counts();
-        println!("scan odometry: {matched} scans matched, {dead} kept the raw odometry's increment");
+        let (matched, turned, dead) = filter.scan_odometry_counts();
+        let turned = match turned {
+            0 => String::new(),
+            n => format!(" ({n} of them moving the other way than the odometry said)"),
+        };
+        println!("scan odometry: {matched} scans matched{turned}, {dead} kept the raw odometry's increment");
     }
     if let Some(l) = &loops {
         println!("loop closure: {}", describe_loops(l, filter.params().loop_closure.online, c.processed));
@@ -412,8 +416,8 @@ pub fn run(args: SlamArgs) -> Result<ExitCode> {
             },
             "odometry_jumps": jumps.len(),
             "scan_odometry": filter.params().scan_odometry.enabled.then(|| {
-                let (matched, dead) = filter.scan_odometry_counts();
-                json!({ "matched": matched, "raw": dead })
+                let (matched, turned_round, dead) = filter.scan_odometry_counts();
+                json!({ "matched": matched, "turned_round": turned_round, "raw": dead })
             }),
             "loop_closure": loops.map(|l| json!({
                 "online": filter.params().loop_closure.online,

@@ -154,9 +154,13 @@ impl Rbpf {
         self.odo_pose
     }
 
-    /// Scans the scan odometry matched and scans whose raw increment it kept; zeros when off.
-    pub fn scan_odometry_counts(&self) -> (usize, usize) {
-        self.scan_odometry.as_ref().map_or((0, 0), |s| s.counts())
+    /// Scans the scan odometry matched, of those the ones matched with their increment turned round, and scans
+    /// whose raw increment it kept; zeros when off.
+    pub fn scan_odometry_counts(&self) -> (usize, usize, usize) {
+        self.scan_odometry.as_ref().map_or((0, 0, 0), |s| {
+            let (matched, dead) = s.counts();
+            (matched, s.turned_round(), dead)
+        })
     }
 
     /// Feeds one odometry reading and the scan taken with it.
