@@ -86,7 +86,8 @@ pub struct LoopClosureParams {
     /// a wall of the submap, falling as a Gaussian of the distance, σ 2 cells).
     pub min_score: f64,
     /// `loop_max_rival`: a branch and bound answer is refused when another pose at least a metre from it scores
-    /// this fraction of its score or more (along a featureless corridor every offset scores alike).
+    /// this fraction of its score or more (along a featureless corridor every offset scores alike), unless the
+    /// answers so refused lately agree (see the online graph's `agrees_with_rivalled`).
     pub max_rival: f64,
     /// `loop_max_searches`: submaps a processed scan is searched against at most (the nearest).
     pub max_searches: usize,

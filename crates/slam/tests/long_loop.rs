@@ -14,7 +14,7 @@ const CORRIDOR: f64 = 3.0;
 
 fn run(seed: u64) -> SyntheticRun {
     let map = synthetic::ring_building(W, H, CORRIDOR, 3);
-    let path = synthetic::waypoint_path(&synthetic::ring_loop(W, H, CORRIDOR, 15.0), 0.1, 0.1);
+    let path = synthetic::waypoint_path(&synthetic::ring_loop(W, H, CORRIDOR, 30.0), 0.1, 0.1);
     let drift = Drift { scale: 0.03, heading_per_m: 0.02, sigma_trans: 0.05, sigma_rot: 0.05 };
     synthetic::simulate(&map, &path, 0.1, &Lidar::sick(), pose(0.1, 0.0, 0.0), &drift, seed)
 }
@@ -27,16 +27,18 @@ fn error_at(run: &SyntheticRun, first: &Pose2, estimate: &Pose2, k: usize) -> f6
 }
 
 #[test]
-#[ignore = "fails today (2026-12-04): seed 0 is 1.6 m off when back at the start, 5.8 m at the end; the next step of [slam-general]"]
+#[ignore = "fails today (2026-12-06): seed 0 now closes the loop (end 0.13 m; before, an alias on the search window's edge left it 5.8 m off), but the pose it holds 20 m after the return is still 1.5 m off: while driving, the optimisation (4 iterations, loop edges under Huber's loss, weak along the corridor) pulls little; the next step of [slam-general]"]
 fn a_200_m_loop_is_closed_on_every_seed_while_driving() {
     let data = run(7);
     let driven: f64 =
         data.truth.windows(2).map(|w| (w[1].1.translation.vector - w[0].1.translation.vector).norm()).sum();
     assert!(driven > 200.0, "{driven} m");
-    // Back at the start: the first scan of the second pass 5 m into the bottom corridor.
+    // Back at the start: the first scan of the second pass 20 m into the bottom corridor, 10 m before the end (in
+    // look-alike corridors one scan's match is ambiguous: the loop is closed once answers agree over 2 m of driving,
+    // and the graph optimised once 10 more scans were processed).
     let c = 0.15 + 0.5 * CORRIDOR;
     let half = data.truth.len() / 2;
-    let back = (half..data.truth.len()).find(|&k| (data.truth[k].1.translation.x - (c + 5.0)).abs() < 0.06).unwrap();
+    let back = (half..data.truth.len()).find(|&k| (data.truth[k].1.translation.x - (c + 20.0)).abs() < 0.06).unwrap();
     let odometry_end = error_at(&data, &data.odometry[0].pose, &data.odometry[back].pose, back);
     assert!(odometry_end > 5.0, "the odometry must leave the loop wide open: {odometry_end} m");
     for seed in 0..3 {

@@ -7,10 +7,11 @@
 //! the finished submaps it may be in, passed at least `loop_min_travel` metres of driving ago, by branch and
 //! bound over a window around where the graph puts it, a window that grows with the driving since the last
 //! closure (a loop's drift grows with its length) at the rate the log's own closures showed, never below
-//! the `window_per_metre` one. A match whose mean score reaches `min_score` and whose refinement matches
-//! `min_matched` of the beams becomes a loop edge (the matcher's information, Huber's kernel); the graph is
-//! optimised a few nodes later, and loop edges it cannot reconcile (a Mahalanobis distance above
-//! `max_residual` once optimised) are dropped, worst first. The filter is then re-anchored on the graph
+//! the `window_per_metre` one. A match whose mean score reaches `min_score`, which is not on its window's edge,
+//! which no pose a metre away rivals (`max_rival`; or, along a corridor, whose rivalled answers agree over metres
+//! of driving) and whose refinement matches `min_matched` of the beams becomes a loop edge (the matcher's
+//! information, Huber's kernel); the graph is optimised a few nodes later, and loop edges it cannot reconcile (a
+//! Mahalanobis distance above `max_residual` once optimised) are dropped, worst first. The filter is then re-anchored on the graph
 //! (see [`crate::Rbpf`]): its map is redrawn from the optimised poses, so the map it matches against, and
 //! the one it outputs, are loop-closed at every moment.
 
@@ -37,6 +38,15 @@ const FINAL_ITERATIONS: u32 = 20;
 const PYRAMID_DEPTH: usize = 5;
 /// Times the drift rate a closure showed that the search window allows from then on.
 const DRIFT_MARGIN: f64 = 2.0;
+/// Answers refused by the rival check that must agree before one is kept ([`LoopGraph::agrees_with_rivalled`]).
+const CONSISTENT_RIVALLED: usize = 3;
+/// Metres of driving the agreeing answers must span at least.
+const CONSISTENT_TRAVEL: f64 = 2.0;
+/// Metres of driving over which refused answers are remembered.
+const CONSISTENT_WINDOW: f64 = 10.0;
+/// How closely agreeing answers move the node: metres and radians.
+const CONSISTENT_M: f64 = 0.2;
+const CONSISTENT_RAD: f64 = 0.03;
 /// The drift rates the windows allow grow to at most this many times `window_per_metre` and
 /// `heading_window_per_metre`.
 const MAX_DRIFT_GROWTH: f64 = 4.0;
@@ -74,6 +84,8 @@ pub struct LoopGraph {
     drift: (f64, f64),
     /// The revisit being driven: travel at its start and whether a loop edge was found in it.
     revisit: Option<(f64, bool)>,
+    /// Answers the rival check refused lately: submap, the move they make of the node (its frame), travel at it.
+    rivalled: Vec<(usize, Xyt, f64)>,
     report: LoopClosureReport,
 }
 
@@ -101,6 +113,7 @@ impl LoopGraph {
             since_optimised: 0,
             reach: Vec::new(),
             revisit: None,
+            rivalled: Vec::new(),
             report: LoopClosureReport::default(),
         }
     }
@@ -298,9 +311,36 @@ impl LoopGraph {
         };
         let predicted = in_anchor_frame(&anchor, &[self.nodes[k].pose])[0];
         let points = search_points(scan, &self.matcher, grids.cell);
-        let found = branch_and_bound_pose(&grids, &points, &predicted, window, self.params.min_score)
-            .filter(|f| f.rival < self.params.max_rival)?;
+        let found = branch_and_bound_pose(&grids, &points, &predicted, window, self.params.min_score)?;
+        if found.rival >= self.params.max_rival && !self.agrees_with_rivalled(i, k, &predicted, &found.pose) {
+            return None;
+        }
         refine_to_edge(&grids, &self.matcher, scan, &found, &self.params, (s.first, k))
+    }
+
+    /// Records an answer the rival check refused (node `k` against submap `i`: found at `pose` where the graph
+    /// predicted `predicted`, submap frame) and says whether the answers refused before it against the same
+    /// submap agree with it: [`CONSISTENT_RIVALLED`] of them, over at least [`CONSISTENT_TRAVEL`] metres of
+    /// driving, moving the robot alike within [`CONSISTENT_M`] and [`CONSISTENT_RAD`]. Along a corridor one scan
+    /// cannot tell its place from one a metre along; places that agree as the robot drives on past different
+    /// walls can.
+    fn agrees_with_rivalled(&mut self, i: usize, k: usize, predicted: &Xyt, pose: &Xyt) -> bool {
+        let shift = in_anchor_frame(predicted, &[*pose])[0];
+        let travel = self.travel[k];
+        self.rivalled.retain(|r| travel - r.2 <= CONSISTENT_WINDOW);
+        let agreeing: Vec<f64> = self
+            .rivalled
+            .iter()
+            .filter(|r| r.0 == i)
+            .filter(|r| {
+                (r.1.x - shift.x).hypot(r.1.y - shift.y) <= CONSISTENT_M
+                    && mrslam_core::pose::normalize_angle(r.1.theta - shift.theta).abs() <= CONSISTENT_RAD
+            })
+            .map(|r| r.2)
+            .collect();
+        self.rivalled.push((i, shift, travel));
+        let first = agreeing.iter().copied().fold(travel, f64::min);
+        agreeing.len() + 1 >= CONSISTENT_RIVALLED && travel - first >= CONSISTENT_TRAVEL
     }
 
     /// Keeps a loop edge and learns from it how far the robot drifted since the last closure.
@@ -457,6 +497,26 @@ mod tests {
         // Closed while driving: the poses the graph held a node after the first closure were already pulled in.
         let first = (0..history.len()).find(|&k| error_to(&truth[..=k], &history[k]).1 < 0.2 && k > truth.len() / 2);
         assert!(first.is_some_and(|k| k + 1 < truth.len()), "no node of the second pass was placed within 0.2 m");
+    }
+
+    #[test]
+    fn answers_the_rival_check_refused_are_kept_once_they_agree_over_metres_of_driving() {
+        let (_, _, laser) = office_nodes();
+        let p = crate::SlamParams::matched();
+        let mut graph = LoopGraph::new(p.loop_closure, &p.matcher, p.map, laser);
+        graph.travel = (0..8).map(f64::from).collect();
+        let at = |x: f64, y: f64| Xyt { x, y, theta: 0.0 };
+        let predicted = at(0.0, 0.0);
+        // The same move (1.2 m along, -1.3 m across) at 0 and 1 m: not yet; at 2 m, three answers over 2 m: kept.
+        assert!(!graph.agrees_with_rivalled(4, 0, &predicted, &at(1.2, -1.3)));
+        assert!(!graph.agrees_with_rivalled(4, 1, &predicted, &at(1.25, -1.28)));
+        assert!(graph.agrees_with_rivalled(4, 2, &predicted, &at(1.18, -1.31)));
+        // Against another submap the answers do not count; nor does one that moves the node elsewhere.
+        assert!(!graph.agrees_with_rivalled(5, 3, &predicted, &at(1.2, -1.3)));
+        assert!(!graph.agrees_with_rivalled(4, 3, &predicted, &at(2.4, -1.3)));
+        // The move is taken in the predicted pose's frame: a prediction turned a half turn moves the answer with it.
+        let turned = Xyt { x: 0.0, y: 0.0, theta: std::f64::consts::PI };
+        assert!(!graph.agrees_with_rivalled(4, 4, &turned, &at(1.2, -1.3)));
     }
 
     #[test]

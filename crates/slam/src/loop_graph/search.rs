@@ -109,6 +109,12 @@ pub fn branch_and_bound_pose(
             .collect();
     found.sort_by(|a, b| b.0.cmp(&a.0).then(a.1.abs().cmp(&b.1.abs())).then(a.1.cmp(&b.1)));
     let &(score, k, ox, oy) = found.first()?;
+    // An answer on the window's edge is the best inside it, not a peak: the true pose (or a better one) may lie
+    // beyond, so the match is not kept.
+    let on_edge = ox <= win.x0 || ox >= win.x1 || oy <= win.y0 || oy >= win.y1;
+    if on_edge {
+        return None;
+    }
     let rival = found
         .iter()
         .find(|r| (r.2 - ox).abs() >= separation || (r.3 - oy).abs() >= separation)
