@@ -416,3 +416,41 @@ fn a_recorded_run_holds_the_filter_as_it_went_and_the_relations_errors() {
     assert_eq!(o.status.code(), Some(1), "{}", text(&o.stderr));
     assert!(text(&o.stderr).contains("--rrd"), "{}", text(&o.stderr));
 }
+
+#[test]
+fn a_log_whose_odometry_is_stamped_in_bursts_maps_on_the_scans_own_odometry() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = office_run();
+    // Each scan line carries its odometry; the ODOM lines come four at a time, stamped within a millisecond of the
+    // burst's last scan (a logger that stamps on arrival what it buffered).
+    let own = carmen_lines(&run);
+    let mut lines = own[..2].to_vec();
+    for (group, scans) in own[2..].chunks(4).enumerate() {
+        let last = &run.odometry[(4 * group + scans.len() - 1).min(run.odometry.len() - 1)];
+        for (j, o) in run.odometry[4 * group..4 * group + scans.len()].iter().enumerate() {
+            let Xyt { x, y, theta: t } = Xyt::from_pose(&o.pose);
+            let stamp = last.stamp + 1e-4 * j as f64;
+            lines.push(format!("ODOM {x:.6} {y:.6} {t:.6} 0 0 0 {stamp:.4} synthetic {stamp:.4}"));
+        }
+        lines.extend_from_slice(scans);
+    }
+    let log = write_log(dir.path(), "bursts.clf", &lines);
+    let info = mrslam(&["log", "info", log.to_str().unwrap()]);
+    let info = text(&info.stdout);
+    assert!(info.contains("the scan lines' own odometry fields (240 scans)"), "{info}");
+    assert!(info.contains("stamped in bursts (180 of its increments faster than 5 m/s"), "{info}");
+    let rel = dir.path().join("office.relations");
+    std::fs::write(&rel, true_relations(&run, 10)).unwrap();
+    let mut trajectories = Vec::new();
+    for extra in [&[][..], &["--odometry", "line"][..]] {
+        let traj = dir.path().join(format!("bursts{}.txt", extra.len()));
+        let mut args = vec!["--trajectory", traj.to_str().unwrap()];
+        args.extend_from_slice(extra);
+        let (out, s) = slam_scored(&log, &rel, &args);
+        assert!(s["metric"]["translation_mean_m"].as_f64().unwrap() < 0.05, "{out}");
+        assert_eq!(s["repairs"]["odometry_stamped_in_bursts"].as_bool(), Some(true), "{s}");
+        assert_eq!(s["repairs"]["line_odometry"].as_u64(), Some(240), "{s}");
+        trajectories.push(poses_of(&traj));
+    }
+    assert_eq!(trajectories[0], trajectories[1], "read as stamped in bursts, the log maps as on its scan lines");
+}
