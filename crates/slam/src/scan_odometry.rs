@@ -65,11 +65,12 @@ pub struct ScanOdometryParams {
     /// `scan_odometry_reach`, cells: the field reach (as the matcher's `field_reach`). Its increments are
     /// centimetres, so a short reach suffices, and its field is built for every scan.
     pub reach: i32,
-    /// `scan_odometry_turn_round`: also match every increment that moves with its translation turned round, and
-    /// keep it when the scan fits it clearly better ([`TURN_ROUND_MARGIN`]). Why: some robots' odometry counts
-    /// reversing as driving ahead (the speed's magnitude integrated); a log's ODOM lines can say so by their
-    /// speed (the reader's reversing repair), its scan lines' own odometry fields cannot, and the prior on the
-    /// logged increment then holds every match 2 × the reversed distance from the truth.
+    /// `scan_odometry_turn_round`: when an increment's match as logged is doubtful (under 0.8 per beam), also match
+    /// it with its translation turned round, and keep that when the scan fits it clearly better (1.2 times the
+    /// score). Why: some robots' odometry counts reversing as driving ahead (the speed's magnitude integrated); a
+    /// log's ODOM lines can say so by their speed (the reader's reversing repair), its scan lines' own odometry
+    /// fields cannot, and the prior on the logged increment then holds every match 2 × the reversed distance from
+    /// the truth.
     pub turn_round: bool,
 }
 
