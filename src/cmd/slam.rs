@@ -12,7 +12,7 @@ use mrslam_core::map_io;
 use mrslam_core::output::write_file_atomic;
 use mrslam_core::relations::{self, StampedPose};
 use mrslam_core::{Odometry, Pose2};
-use mrslam_log::repair::{MAX_SPEED, MAX_TURN_RATE, faster_than_a_robot};
+use mrslam_log::{MAX_SPEED, MAX_TURN_RATE, faster_than_a_robot};
 use mrslam_slam::synthetic::{Drift, inject_drift};
 use mrslam_slam::{LogRun, LogRunError, Preset, Rbpf, map_log};
 use mrslam_viz::{Level, ProcessedScan, RelationMark, SlamLogRecorder};

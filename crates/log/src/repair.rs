@@ -7,24 +7,11 @@
 //! wrong way turned round, and each scan's odometry interpolated from the odometry stream at its stamp.
 
 use crate::options::{OdometrySource, ReadOptions};
+use crate::robot_speed::faster_than_a_robot;
 use crate::sensor_log::{OdometryRecord, ScanRecord, SensorLog};
 use crate::source::Source;
+use mrslam_core::Odometry;
 use mrslam_core::pose::interpolate;
-use mrslam_core::{Odometry, Pose2};
-
-/// Fastest a robot drives, m/s: odometry readings whose stamps imply more were not stamped when they were
-/// measured (a logger that stamps a buffered burst on arrival), or the robot was carried or reset.
-pub const MAX_SPEED: f64 = 5.0;
-/// Fastest a robot turns, rad/s (see [`MAX_SPEED`]).
-pub const MAX_TURN_RATE: f64 = 10.0;
-
-/// Whether going from `a` to `b` in `seconds` is faster than a robot drives or turns ([`MAX_SPEED`],
-/// [`MAX_TURN_RATE`]).
-pub fn faster_than_a_robot(a: &Pose2, b: &Pose2, seconds: f64) -> bool {
-    let step = a.inv_mul(b);
-    let (distance, turn) = (step.translation.vector.norm(), step.rotation.angle().abs());
-    distance > MAX_SPEED * seconds || turn > MAX_TURN_RATE * seconds
-}
 
 /// A sensor reading stamped too long before one above it (two logs joined, or a clock reset).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -239,7 +226,7 @@ pub fn odometry_at_scans(log: &mut SensorLog, source: OdometrySource, latency: f
 #[cfg(test)]
 mod tests {
     use super::*;
-    use mrslam_core::{LaserScan, Xyt, pose};
+    use mrslam_core::{LaserScan, Pose2, Xyt, pose};
 
     fn scan(stamp: f64, sensor: &str, ranges: &[f32], line: usize) -> ScanRecord {
         ScanRecord {

@@ -78,7 +78,7 @@ pub struct Repairs {
     pub interpolated_odometry: usize,
     /// Scans whose odometry is their own record's.
     pub line_odometry: usize,
-    /// Increments of the odometry stream faster than a robot moves ([`crate::repair::faster_than_a_robot`]).
+    /// Increments of the odometry stream faster than a robot moves ([`crate::faster_than_a_robot`]).
     pub burst_increments: usize,
     /// Whether so many are ([`crate::repair::MAX_BURST_SHARE`]) that the stream is stamped in bursts, not when
     /// measured, and the scans kept their own odometry ([`crate::repair::odometry_at_scans`]).
@@ -128,8 +128,8 @@ impl Repairs {
                 "{text}: the odometry stream is stamped in bursts ({} of its increments faster than {} m/s or {} \
                  rad/s), its stamps are not when it was measured",
                 self.burst_increments,
-                crate::repair::MAX_SPEED,
-                crate::repair::MAX_TURN_RATE
+                crate::robot_speed::MAX_SPEED,
+                crate::robot_speed::MAX_TURN_RATE
             )
         } else {
             text
