@@ -517,10 +517,10 @@ struct OdometryJump {
 fn odometry_jumps(odometry: &[Odometry], scans: &[mrslam_log::ScanRecord]) -> Vec<OdometryJump> {
     let mut jumps = Vec::new();
     for (k, w) in odometry.windows(2).enumerate() {
-        let step = w[0].pose.inv_mul(&w[1].pose);
-        let (distance, turn) = (step.translation.vector.norm(), step.rotation.angle().abs());
         let seconds = w[1].stamp - w[0].stamp;
         if faster_than_a_robot(&w[0].pose, &w[1].pose, seconds.max(0.1)) {
+            let step = w[0].pose.inv_mul(&w[1].pose);
+            let (distance, turn) = (step.translation.vector.norm(), step.rotation.angle().abs());
             jumps.push(OdometryJump { at: scans[k + 1].source.clone(), distance, turn, seconds });
         }
     }

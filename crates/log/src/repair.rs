@@ -175,7 +175,7 @@ pub fn drop_repeated_scans(log: &mut SensorLog) {
 pub const MAX_BURST_SHARE: f64 = 0.01;
 
 /// The increments of an odometry stream (in stamp order) faster than a robot moves.
-pub fn burst_increments(odometry: &[OdometryRecord]) -> usize {
+fn burst_increments(odometry: &[OdometryRecord]) -> usize {
     odometry
         .windows(2)
         .filter(|w| {

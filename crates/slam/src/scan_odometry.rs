@@ -189,7 +189,7 @@ impl ScanOdometry {
                     self.matched += 1;
                     OdometryStep::Matched
                 } else {
-                    self.pose = Xyt::from_pose(&(self.pose.to_pose() * pose(dx, dy, dt)));
+                    self.pose = self.predict((dx, dy, dt));
                     self.dead += 1;
                     OdometryStep::Dead
                 }
@@ -211,7 +211,7 @@ impl ScanOdometry {
         if prepared.matched.is_empty() {
             return None;
         }
-        let predicted = Xyt::from_pose(&(self.pose.to_pose() * pose(dx, dy, dt)));
+        let predicted = self.predict((dx, dy, dt));
         let [sx, sy, st] = self.noise.sigmas(dx, dy, dt);
         let prior = MotionPrior {
             sx: sx.max(MIN_PRIOR_SIGMA[0]),
@@ -220,6 +220,11 @@ impl ScanOdometry {
         };
         let m = self.matcher.match_scan(&self.submaps[older].0, &predicted, prepared, Some(&prior), &mut self.scratch);
         (m.accepted && m.matched as f64 >= MIN_MATCHED_FRACTION * prepared.matched.len() as f64).then_some(m)
+    }
+
+    /// The last pose moved by `increment` (robot frame).
+    fn predict(&self, (dx, dy, dt): (f64, f64, f64)) -> Xyt {
+        Xyt::from_pose(&(self.pose.to_pose() * pose(dx, dy, dt)))
     }
 
     /// Inserts the scan's hits at the current pose into the submaps, replacing a full one by an empty one.

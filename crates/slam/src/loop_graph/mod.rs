@@ -11,9 +11,9 @@
 //! which no pose a metre away rivals (`max_rival`; or, along a corridor, whose rivalled answers agree over metres
 //! of driving) and whose refinement matches `min_matched` of the beams becomes a loop edge (the matcher's
 //! information, Huber's kernel); the graph is optimised a few nodes later, and loop edges it cannot reconcile (a
-//! Mahalanobis distance above `max_residual` once optimised) are dropped, worst first. The filter is then re-anchored on the graph
-//! (see [`crate::Rbpf`]): its map is redrawn from the optimised poses, so the map it matches against, and
-//! the one it outputs, are loop-closed at every moment.
+//! Mahalanobis distance above `max_residual` once optimised) are dropped, worst first. The filter is then
+//! re-anchored on the graph (see [`crate::Rbpf`]): its map is redrawn from the optimised poses, so the map it
+//! matches against, and the one it outputs, are loop-closed at every moment.
 
 mod search;
 mod submap;
@@ -44,8 +44,9 @@ const CONSISTENT_RIVALLED: usize = 3;
 const CONSISTENT_TRAVEL: f64 = 2.0;
 /// Metres of driving over which refused answers are remembered.
 const CONSISTENT_WINDOW: f64 = 10.0;
-/// How closely agreeing answers move the node: metres and radians.
+/// How closely agreeing answers move the node, metres.
 const CONSISTENT_M: f64 = 0.2;
+/// How closely agreeing answers turn the node, radians.
 const CONSISTENT_RAD: f64 = 0.03;
 /// The drift rates the windows allow grow to at most this many times `window_per_metre` and
 /// `heading_window_per_metre`.
@@ -328,19 +329,18 @@ impl LoopGraph {
         let shift = in_anchor_frame(predicted, &[*pose])[0];
         let travel = self.travel[k];
         self.rivalled.retain(|r| travel - r.2 <= CONSISTENT_WINDOW);
-        let agreeing: Vec<f64> = self
+        // This answer and the earlier ones agreeing with it: how many, and the travel at the first.
+        let (count, first) = self
             .rivalled
             .iter()
-            .filter(|r| r.0 == i)
             .filter(|r| {
-                (r.1.x - shift.x).hypot(r.1.y - shift.y) <= CONSISTENT_M
+                r.0 == i
+                    && (r.1.x - shift.x).hypot(r.1.y - shift.y) <= CONSISTENT_M
                     && mrslam_core::pose::normalize_angle(r.1.theta - shift.theta).abs() <= CONSISTENT_RAD
             })
-            .map(|r| r.2)
-            .collect();
+            .fold((1, travel), |(n, first), r| (n + 1, first.min(r.2)));
         self.rivalled.push((i, shift, travel));
-        let first = agreeing.iter().copied().fold(travel, f64::min);
-        agreeing.len() + 1 >= CONSISTENT_RIVALLED && travel - first >= CONSISTENT_TRAVEL
+        count >= CONSISTENT_RIVALLED && travel - first >= CONSISTENT_TRAVEL
     }
 
     /// Keeps a loop edge and learns from it how far the robot drifted since the last closure.
