@@ -2,9 +2,12 @@
 //! ([`crate::scan_matcher::MatcherKind::Field`]).
 //!
 //! GMapping's matcher searches, for every beam end point and every pose it tries, a (2k+1)² window of cells
-//! for the nearest cell mean. The likelihood field does that search once per particle and update instead:
-//! over a window covering the scan, every cell stores the *surface elements* (surfels) nearest to its centre
-//! within `reach` cells, so scoring a beam is one table read.
+//! for the nearest cell mean. The likelihood field does that search once per cell and update instead: over a
+//! window covering the scan, a cell stores the *surface elements* (surfels) nearest to its centre within
+//! `reach` cells, so scoring a beam is one table read. A cell is searched when a lookup first reads it, and a
+//! surfel computed when a search first needs it: a scan's lookups read about one cell in forty of the window
+//! (FR079: 1.1 thousand of 43 thousand per build), so filling every cell up front cost three quarters of the
+//! SLAM's time.
 //!
 //! A surfel is made from an occupied cell: where the means of the occupied cells around it (±2 cells,
 //! weighted by their hits) lie on a line, the cell's mean projected onto that line plus the line's normal,
@@ -27,9 +30,11 @@
 //! Cells with no surfel within reach keep whether the particle's map has seen them (see
 //! [`crate::MatcherParams::seen_band`]). The field is rebuilt for each particle at each update into reused
 //! buffers ([`Field::build`]), which are never cleared: slots carry the number of the build that wrote them.
-//! It is derived data, never shared or stored; results do not depend on which buffer a build reuses.
+//! It is derived data, never shared or stored; results depend neither on which buffer a build reuses nor on
+//! the order of the lookups (a cell's search depends only on the map).
 
 use crate::tile_map::{DIR_SCALE, TILE, TILE_SHIFT, TileMap, local};
+use std::cell::Cell;
 
 /// A surface element: the nearest occupied cell's mean (window-relative metres), the unit normal of the
 /// surface there (×[`NORMAL_SCALE`]), and what kind of surfel it is ([`Surfel::LINE`], [`Surfel::ORIENTED`]
@@ -127,12 +132,13 @@ pub struct Field {
     stamp: u16,
     /// Per cell the nearest surfel of each of two orientation classes (normal nearer the x axis, nearer the y
     /// axis; point surfels in the first): at a corner, a beam end point is measured to both faces and takes
-    /// the nearer, as GMapping's kernel search takes the nearest mean around the point itself.
-    cells: Vec<[Surfel; 2]>,
+    /// the nearer, as GMapping's kernel search takes the nearest mean around the point itself. Filled when a
+    /// lookup first reads the cell (a scan's lookups read about one cell in forty of its window).
+    cells: Vec<Cell<[Surfel; 2]>>,
     /// Seen flags of the window's cells, one bit per cell.
     seen: Vec<u64>,
-    /// Build scratch: squared distance from each cell's centre to its surfels (plus the point penalty).
-    best: Vec<[f32; 2]>,
+    /// The padded window's and the blocks' sizes, and the build's reach.
+    geometry: Geometry,
     /// Build scratch: per cell of the padded window, 1 + index into `occupied`, or 0.
     occ: Vec<u32>,
     /// Build scratch: occupied cells of the padded window: padded x, padded y, mean (metres from the window's
@@ -142,13 +148,29 @@ pub struct Field {
     needed: Vec<bool>,
     /// Build scratch: the points of [`Field::build_near`].
     near: Vec<(f64, f64, f64)>,
-    /// Build scratch: each occupied cell's surfel and where it sits.
-    surfels: Vec<Placed>,
+    /// Each occupied cell's surfel and the penalty it carries in the contest for the cells around it, computed
+    /// when a lookup first needs it ([`Surfel::NONE`] where the cell's block is not needed).
+    surfels: Vec<Cell<Option<(Surfel, f32)>>>,
 }
 
-/// An occupied cell's surfel placed in the window: the cell (window coordinates) and its mean (metres from the
-/// window's origin; the contest for the cells around it measures from there), the surfel, and the penalty it
-/// carries in that contest.
+/// The sizes a build works in: the padding around the window (cells), the padded window's width and height,
+/// the needed-block grid's columns and rows, the reach (cells, and squared metres from a cell's centre), and
+/// whether surfels are lines.
+#[derive(Debug, Clone, Copy, Default)]
+struct Geometry {
+    pad: i32,
+    pw: i32,
+    ph: i32,
+    bw: i32,
+    bh: i32,
+    reach: i32,
+    reach2: f32,
+    lines: bool,
+}
+
+/// An occupied cell's surfel placed in the window, for the eager reference build of the tests: the cell (window
+/// coordinates) and its mean (metres from the window's origin), the surfel, and its penalty.
+#[cfg(test)]
 #[derive(Debug, Clone, Copy)]
 struct Placed {
     wx: i32,
@@ -159,12 +181,9 @@ struct Placed {
     penalty: f32,
 }
 
-impl Placed {
-    /// No surfel (its occupied cell is not needed).
-    const NONE: Placed = Placed { wx: 0, wy: 0, mx: 0.0, my: 0.0, surfel: EMPTY, penalty: 0.0 };
-}
-
-/// The splat's view of a build: the window's size, the reach (cells, and squared metres), the cell size.
+/// The eager build's view of a window, kept as the tests' reference: its size, the reach (cells, and squared
+/// metres), the cell size.
+#[cfg(test)]
 #[derive(Debug, Clone, Copy)]
 struct Band {
     w: i32,
@@ -174,6 +193,7 @@ struct Band {
     stamp: u16,
 }
 
+#[cfg(test)]
 impl Band {
     /// Splats `surfels` onto the window's rows from `row0` on, whose cells and best distances are `cells` and
     /// `best`: each cell within reach of a surfel's mean keeps the nearest of each orientation class.
@@ -272,10 +292,10 @@ impl Field {
     /// The surfel nearest to window-relative point (u, v) within reach that a beam of unit direction
     /// (dx, dy) can end on, and its squared distance.
     #[inline]
-    pub fn nearest(&self, u: f64, v: f64, dx: f64, dy: f64) -> Option<(&Surfel, f64)> {
-        let [a, b] = &self.cells[self.index(u, v)?];
-        let da = self.candidate(a, u, v, dx, dy);
-        let db = self.candidate(b, u, v, dx, dy);
+    pub fn nearest(&self, u: f64, v: f64, dx: f64, dy: f64) -> Option<(Surfel, f64)> {
+        let [a, b] = self.surfels_at(self.index(u, v)?);
+        let da = self.candidate(&a, u, v, dx, dy);
+        let db = self.candidate(&b, u, v, dx, dy);
         if da <= db { da.is_finite().then_some((a, da)) } else { Some((b, db)) }
     }
 
@@ -291,8 +311,8 @@ impl Field {
     #[inline]
     pub fn lookup(&self, u: f64, v: f64, dx: f64, dy: f64) -> Lookup {
         let Some(i) = self.index(u, v) else { return Lookup::Unseen };
-        let [a, b] = &self.cells[i];
-        let d = self.candidate(a, u, v, dx, dy).min(self.candidate(b, u, v, dx, dy));
+        let [a, b] = self.surfels_at(i);
+        let d = self.candidate(&a, u, v, dx, dy).min(self.candidate(&b, u, v, dx, dy));
         if d.is_finite() {
             Lookup::Hit(d)
         } else if self.seen[i >> 6] >> (i & 63) & 1 != 0 {
@@ -354,8 +374,7 @@ impl Field {
             self.stamp = 1;
         }
         if self.cells.len() < n {
-            self.cells.resize(n, [EMPTY; 2]);
-            self.best.resize(n, [f32::INFINITY; 2]);
+            self.cells.resize(n, Cell::new([EMPTY; 2]));
         }
         self.seen.clear();
         self.seen.resize(n.div_ceil(64), 0);
@@ -424,66 +443,114 @@ impl Field {
             }
         }
 
-        // Pass 2: each needed occupied cell's surfel (in parallel halves), then the surfels splatted onto the
-        // cells within reach of their means (in parallel bands of rows). Both split the work into disjoint
-        // parts processed in the same order as one pass would, so the field does not depend on the threads.
-        let mut surfels = std::mem::take(&mut self.surfels);
-        surfels.clear();
-        surfels.resize(self.occupied.len(), Placed::NONE);
-        let mid = surfels.len() / 2;
-        let (first, second) = surfels.split_at_mut(mid);
-        let this = &*self;
-        let geometry = (pad, pw, ph, bw, bh);
-        rayon::join(|| this.surfels_of(0, first, geometry, lines), || this.surfels_of(mid, second, geometry, lines));
+        // The surfels and the cells' nearest surfels are computed when a lookup first needs them.
+        self.surfels.clear();
+        self.surfels.resize(self.occupied.len(), Cell::new(None));
         let reach2 = ((reach as f64 + 0.5) * delta).powi(2) as f32;
-        let rows = self.h as usize / 2;
-        let w = self.w as usize;
-        let (cells_a, cells_b) = self.cells[..n].split_at_mut(rows * w);
-        let (best_a, best_b) = self.best[..n].split_at_mut(rows * w);
-        let band = Band { w: self.w, reach, reach2, delta: delta as f32, stamp: self.stamp };
-        rayon::join(|| band.splat(&surfels, 0, cells_a, best_a), || band.splat(&surfels, rows as i32, cells_b, best_b));
-        self.surfels = surfels;
+        self.geometry = Geometry { pad, pw, ph, bw, bh, reach, reach2, lines };
     }
 
-    /// The surfels of occupied cells `offset..offset + out.len()` into `out` ([`Placed::NONE`] where the cell's
-    /// block is not needed). `geometry`: padding, padded width and height, block columns and rows.
-    fn surfels_of(&self, offset: usize, out: &mut [Placed], geometry: (i32, i32, i32, i32, i32), lines: bool) {
-        let (pad, pw, ph, bw, bh) = geometry;
-        let point_penalty = (POINT_PENALTY * self.delta * self.delta) as f32;
-        for (k, slot) in (offset..).zip(out.iter_mut()) {
-            let (ox, oy, mx, my, hits, dir) = self.occupied[k];
-            let (bx, by) = (((ox - pad) / BLOCK).clamp(0, bw - 1), ((oy - pad) / BLOCK).clamp(0, bh - 1));
-            if !self.needed[(by * bw + bx) as usize] {
-                continue;
-            }
-            let mut s = Surfel { mx, my, nx: 0, ny: 0, kind: 0, stamp: self.stamp };
-            // a point surfel's normal: the mean direction back to the sensors that saw it
-            let (ddx, ddy) = (dir[0] as f64, dir[1] as f64);
-            let dlen = (ddx * ddx + ddy * ddy).sqrt();
-            if dlen > ORIENTED_FRACTION * hits as f64 * DIR_SCALE {
-                s.nx = (-ddx / dlen * NORMAL_SCALE).round() as i16;
-                s.ny = (-ddy / dlen * NORMAL_SCALE).round() as i16;
-                s.kind = Surfel::ORIENTED;
-            }
-            let mut penalty = if lines { point_penalty } else { 0.0 };
-            if lines
-                && let Some((nx, ny, c, oriented)) =
-                    self.line(ox, oy, pw, ph, NORMAL_RADIUS).or_else(|| self.line(ox, oy, pw, ph, 1))
-            {
-                penalty = 0.0;
-                // the cell's mean projected onto the line
-                let off = nx * mx as f64 + ny * my as f64 - c;
-                s = Surfel {
-                    mx: (mx as f64 - off * nx) as f32,
-                    my: (my as f64 - off * ny) as f32,
-                    nx: (nx * NORMAL_SCALE).round() as i16,
-                    ny: (ny * NORMAL_SCALE).round() as i16,
-                    kind: Surfel::LINE | if oriented { Surfel::ORIENTED } else { 0 },
-                    stamp: self.stamp,
-                };
-            }
-            *slot = Placed { wx: ox - pad, wy: oy - pad, mx, my, surfel: s, penalty };
+    /// The nearest surfels of window cell `i`, found on the first call of this build.
+    #[inline]
+    fn surfels_at(&self, i: usize) -> [Surfel; 2] {
+        let pair = self.cells[i].get();
+        if pair[0].stamp == self.stamp {
+            return pair;
         }
+        let pair = self.nearest_surfels(i);
+        self.cells[i].set(pair);
+        pair
+    }
+
+    /// Of the surfels whose occupied cell lies within reach of window cell `i` (its mean within reach of the
+    /// cell's centre), the nearest of each orientation class, counting the point penalty; on a tie, the first
+    /// occupied cell in the order of the build's pass over the tiles. Empty classes hold a [`Surfel::NONE`]
+    /// stamped with the build, so that the cell counts as found.
+    fn nearest_surfels(&self, i: usize) -> [Surfel; 2] {
+        let g = self.geometry;
+        let w = self.w as usize;
+        let (x, y) = ((i % w) as i32, (i / w) as i32);
+        let d32 = self.delta as f32;
+        let (cx, cy) = ((x as f32 + 0.5) * d32, (y as f32 + 0.5) * d32);
+        let none = Surfel { stamp: self.stamp, ..EMPTY };
+        // per class: penalised squared distance, occupied index, surfel
+        let mut best = [(f32::INFINITY, u32::MAX, none); 2];
+        let (xa, xb) = ((x + g.pad - g.reach) as usize, (x + g.pad + g.reach) as usize);
+        for py in y + g.pad - g.reach..=y + g.pad + g.reach {
+            let row = py as usize * g.pw as usize;
+            for &k in &self.occ[row + xa..=row + xb] {
+                if k == 0 {
+                    continue;
+                }
+                let (_, _, mx, my, _, _) = self.occupied[k as usize - 1];
+                let (ex, ey) = (cx - mx, cy - my);
+                let d2 = ex * ex + ey * ey;
+                if d2 > g.reach2 {
+                    continue;
+                }
+                let (s, penalty) = self.surfel(k as usize - 1);
+                if s.kind & Surfel::NONE != 0 {
+                    continue;
+                }
+                let class = usize::from(s.kind & Surfel::LINE != 0 && s.ny.unsigned_abs() > s.nx.unsigned_abs());
+                let d = d2 + penalty;
+                let b = &mut best[class];
+                if d < b.0 || (d == b.0 && k < b.1) {
+                    *b = (d, k, s);
+                }
+            }
+        }
+        [best[0].2, best[1].2]
+    }
+
+    /// The surfel of occupied cell `k` and its penalty, computed on the first call of this build.
+    #[inline]
+    fn surfel(&self, k: usize) -> (Surfel, f32) {
+        if let Some(found) = self.surfels[k].get() {
+            return found;
+        }
+        let found = self.surfel_of(k);
+        self.surfels[k].set(Some(found));
+        found
+    }
+
+    /// The surfel of occupied cell `k` and the penalty it carries in the contest for the cells around it
+    /// (a [`Surfel::NONE`] where the cell's block is not needed).
+    fn surfel_of(&self, k: usize) -> (Surfel, f32) {
+        let Geometry { pad, pw, ph, bw, bh, lines, .. } = self.geometry;
+        let (ox, oy, mx, my, hits, dir) = self.occupied[k];
+        let (bx, by) = (((ox - pad) / BLOCK).clamp(0, bw - 1), ((oy - pad) / BLOCK).clamp(0, bh - 1));
+        if !self.needed[(by * bw + bx) as usize] {
+            return (EMPTY, 0.0);
+        }
+        let mut s = Surfel { mx, my, nx: 0, ny: 0, kind: 0, stamp: self.stamp };
+        // a point surfel's normal: the mean direction back to the sensors that saw it
+        let (ddx, ddy) = (dir[0] as f64, dir[1] as f64);
+        let dlen = (ddx * ddx + ddy * ddy).sqrt();
+        if dlen > ORIENTED_FRACTION * hits as f64 * DIR_SCALE {
+            s.nx = (-ddx / dlen * NORMAL_SCALE).round() as i16;
+            s.ny = (-ddy / dlen * NORMAL_SCALE).round() as i16;
+            s.kind = Surfel::ORIENTED;
+        }
+        if !lines {
+            return (s, 0.0);
+        }
+        let Some((nx, ny, c, oriented)) =
+            self.line(ox, oy, pw, ph, NORMAL_RADIUS).or_else(|| self.line(ox, oy, pw, ph, 1))
+        else {
+            return (s, (POINT_PENALTY * self.delta * self.delta) as f32);
+        };
+        // the cell's mean projected onto the line
+        let off = nx * mx as f64 + ny * my as f64 - c;
+        let line = Surfel {
+            mx: (mx as f64 - off * nx) as f32,
+            my: (my as f64 - off * ny) as f32,
+            nx: (nx * NORMAL_SCALE).round() as i16,
+            ny: (ny * NORMAL_SCALE).round() as i16,
+            kind: Surfel::LINE | if oriented { Surfel::ORIENTED } else { 0 },
+            stamp: self.stamp,
+        };
+        (line, 0.0)
     }
 
     /// The line through the means of the occupied cells within [`NORMAL_RADIUS`] of padded cell (ox, oy),
@@ -694,22 +761,18 @@ mod tests {
     }
 
     #[test]
-    fn the_parallel_build_equals_one_pass_and_a_reused_field_equals_a_fresh_one() {
+    fn the_lazy_field_equals_the_eager_splat_and_a_reused_field_equals_a_fresh_one() {
         let m = cluttered_room();
         let mut reused = Field::default();
         reused.build(&cluttered_room_other(), [-20, -20, 90, 90], 4, true);
         reused.build(&m, [-10, -10, 90, 90], 4, true);
         let mut fresh = Field::default();
         fresh.build(&m, [-10, -10, 90, 90], 4, true);
-        let n = (fresh.w * fresh.h) as usize;
-        // one band over every row, from the same surfels
-        let mut cells = vec![[EMPTY; 2]; n];
-        let mut best = vec![[f32::INFINITY; 2]; n];
-        let reach2 = ((4.0 + 0.5) * fresh.delta).powi(2) as f32;
-        let band = Band { w: fresh.w, reach: 4, reach2, delta: fresh.delta as f32, stamp: fresh.stamp };
-        band.splat(&fresh.surfels, 0, &mut cells, &mut best);
-        assert_eq!(&fresh.cells[..n], &cells[..]);
-        assert!(cells.iter().flatten().any(|s| s.kind & Surfel::LINE != 0));
+        assert_equals_eager_splat(&fresh);
+        // and where only the surfels near some points are computed
+        let mut near = Field::default();
+        near.build_near(&m, [-10, -10, 90, 90], 4, true, [(0.5, 0.2, 0.5), (3.5, 2.0, 0.3)]);
+        assert_equals_eager_splat(&near);
         // the reused buffers give the same lookups as fresh ones
         let (ox, oy) = fresh.origin();
         assert_eq!(reused.origin(), (ox, oy));
@@ -718,6 +781,30 @@ mod tests {
             let (dx, dy) = ((k as f64).cos(), (k as f64).sin());
             assert_eq!(reused.lookup(x - ox, y - oy, dx, dy), fresh.lookup(x - ox, y - oy, dx, dy), "({x}, {y})");
         }
+    }
+
+    /// Asserts that every cell of `f`, looked up lazily, finds what the eager splat of every occupied cell's
+    /// surfel onto the cells within reach of its mean (the build before lookups were lazy) puts there.
+    fn assert_equals_eager_splat(f: &Field) {
+        let n = (f.w * f.h) as usize;
+        let g = f.geometry;
+        let placed: Vec<Placed> = (0..f.occupied.len())
+            .map(|k| {
+                let (ox, oy, mx, my, _, _) = f.occupied[k];
+                let (surfel, penalty) = f.surfel_of(k);
+                Placed { wx: ox - g.pad, wy: oy - g.pad, mx, my, surfel, penalty }
+            })
+            .collect();
+        let mut cells = vec![[EMPTY; 2]; n];
+        let mut best = vec![[f32::INFINITY; 2]; n];
+        let band = Band { w: f.w, reach: g.reach, reach2: g.reach2, delta: f.delta as f32, stamp: f.stamp };
+        band.splat(&placed, 0, &mut cells, &mut best);
+        let found = |pair: [Surfel; 2]| pair.map(|s| (!s.is_none(f.stamp)).then_some(s));
+        for (i, eager) in cells.iter().enumerate() {
+            assert_eq!(found(f.surfels_at(i)), found(*eager), "cell {i}");
+        }
+        assert!(cells.iter().flatten().any(|s| !s.is_none(f.stamp) && s.kind & Surfel::LINE != 0));
+        assert!(cells.iter().flatten().any(|s| s.is_none(f.stamp)));
     }
 
     /// Another map, so that a reused field holds stale surfels where the next build has none.

@@ -146,7 +146,7 @@ impl ScanMatcher {
                 continue;
             }
             let (nx, ny) = sf.normal();
-            let half = f.half(sf);
+            let half = f.half(&sf);
             add([nx, ny, nx * tx + ny * ty], nx * ex + ny * ey, w);
             let along = -ny * ex + nx * ey;
             let over = along.abs() - half;
