@@ -141,6 +141,9 @@ pub struct Field {
     geometry: Geometry,
     /// Build scratch: per cell of the padded window, 1 + index into `occupied`, or 0.
     occ: Vec<u32>,
+    /// Build scratch: the same cells' occupancy, one bit per cell, [`Geometry::words`] words a padded row
+    /// (one spare, so that a row's last bits can be read as a pair of words).
+    occ_bits: Vec<u64>,
     /// Build scratch: occupied cells of the padded window: padded x, padded y, mean (metres from the window's
     /// origin), hits, summed beam directions.
     occupied: Vec<(i32, i32, f32, f32, u32, [i16; 2])>,
@@ -166,6 +169,7 @@ struct Geometry {
     reach: i32,
     reach2: f32,
     lines: bool,
+    words: usize,
 }
 
 /// An occupied cell's surfel placed in the window, for the eager reference build of the tests: the cell (window
@@ -385,6 +389,9 @@ impl Field {
         let (pw, ph) = (self.w + 2 * pad, self.h + 2 * pad);
         self.occ.clear();
         self.occ.resize((pw * ph) as usize, 0);
+        let words = pw as usize / 64 + 2;
+        self.occ_bits.clear();
+        self.occ_bits.resize(words * ph as usize, 0);
         self.occupied.clear();
         let delta = self.delta;
         let (px0, py0) = (cx0 - pad, cy0 - pad);
@@ -420,6 +427,8 @@ impl Field {
                         let my = ((iy - cy0) as f64 * delta + c.mean[1] as f64) as f32;
                         self.occupied.push((ix - px0, iy - py0, mx, my, c.hits as u32, c.dir));
                         self.occ[((iy - py0) * pw + (ix - px0)) as usize] = self.occupied.len() as u32;
+                        let (px, py) = ((ix - px0) as usize, (iy - py0) as usize);
+                        self.occ_bits[py * words + px / 64] |= 1 << (px % 64);
                     }
                 }
             }
@@ -447,7 +456,7 @@ impl Field {
         self.surfels.clear();
         self.surfels.resize(self.occupied.len(), Cell::new(None));
         let reach2 = ((reach as f64 + 0.5) * delta).powi(2) as f32;
-        self.geometry = Geometry { pad, pw, ph, bw, bh, reach, reach2, lines };
+        self.geometry = Geometry { pad, pw, ph, bw, bh, reach, reach2, lines, words };
     }
 
     /// The nearest surfels of window cell `i`, found on the first call of this build.
@@ -475,13 +484,16 @@ impl Field {
         let none = Surfel { stamp: self.stamp, ..EMPTY };
         // per class: penalised squared distance, occupied index, surfel
         let mut best = [(f32::INFINITY, u32::MAX, none); 2];
-        let (xa, xb) = ((x + g.pad - g.reach) as usize, (x + g.pad + g.reach) as usize);
+        // the occupied cells of each padded row from xa to xa + 2 reach, read as a bit mask
+        let xa = (x + g.pad - g.reach) as usize;
+        let (word, shift) = (xa / 64, xa % 64);
+        let span = u64::MAX >> (63 - 2 * g.reach);
         for py in y + g.pad - g.reach..=y + g.pad + g.reach {
-            let row = py as usize * g.pw as usize;
-            for &k in &self.occ[row + xa..=row + xb] {
-                if k == 0 {
-                    continue;
-                }
+            let (bits, row) = (&self.occ_bits[py as usize * g.words + word..], py as usize * g.pw as usize + xa);
+            let mut mask = (bits[0] >> shift | if shift > 0 { bits[1] << (64 - shift) } else { 0 }) & span;
+            while mask != 0 {
+                let k = self.occ[row + mask.trailing_zeros() as usize];
+                mask &= mask - 1;
                 let (_, _, mx, my, _, _) = self.occupied[k as usize - 1];
                 let (ex, ey) = (cx - mx, cy - my);
                 let d2 = ex * ex + ey * ey;
