@@ -15,6 +15,7 @@ use mrslam_core::MAX_CELLS;
 use mrslam_core::Xyt;
 use mrslam_core::map_io::ROS_LOGODDS_LIMIT;
 use mrslam_core::{CellTraversal, LaserScan, OccupancyGrid, pose};
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 /// The grid and the ranges of the beams it is built from (the particles' maps and the output map).
@@ -107,7 +108,6 @@ pub fn build_map(nodes: &[&TrajectoryNode], laser: &Xyt, params: &MapParams) -> 
         return None;
     }
     let mut hits = vec![0u32; w * h];
-    let mut visits = vec![0u32; w * h];
     // Pass 2 (with `wall_hits`): the hits alone, so that pass 3 knows the walls before it traces.
     let wall = params.wall_hits;
     if wall > 0 {
@@ -127,36 +127,50 @@ pub fn build_map(nodes: &[&TrajectoryNode], laser: &Xyt, params: &MapParams) -> 
             }
         }
     }
-    // Pass 3: trace.
-    for n in nodes {
-        let lp = sensor(&n.pose, laser);
-        let (sx, sy) = (lp.x * inv - x0 as f64, lp.y * inv - y0 as f64);
-        for i in 0..n.scan.len() {
-            let Some((r, hit)) = beam_end(&n.scan, i, params) else {
-                continue;
-            };
-            let a = lp.theta + n.scan.angle(i);
-            let (ex, ey) = (sx + r * a.cos() * inv, sy + r * a.sin() * inv);
-            let trav = CellTraversal::new(sx, sy, ex, ey);
-            let end = trav.end_cell();
-            for (cx, cy) in trav {
-                if cx < 0 || cy < 0 || cx as usize >= w || cy as usize >= h {
+    // Pass 3: trace, in parallel runs of nodes, each counting into its own arrays (the counts are sums, so
+    // the map does not depend on the split). With `wall_hits` the traces read pass 2's hits and add none.
+    let trace = |run: &[&TrajectoryNode]| -> (Vec<u32>, Vec<u32>) {
+        let mut visits = vec![0u32; w * h];
+        let mut ends = if wall == 0 { vec![0u32; w * h] } else { Vec::new() };
+        for n in run {
+            let lp = sensor(&n.pose, laser);
+            let (sx, sy) = (lp.x * inv - x0 as f64, lp.y * inv - y0 as f64);
+            for i in 0..n.scan.len() {
+                let Some((r, hit)) = beam_end(&n.scan, i, params) else {
                     continue;
-                }
-                let k = cy as usize * w + cx as usize;
-                visits[k] = visits[k].saturating_add(1);
-                if (cx, cy) == end {
-                    if hit && wall == 0 {
-                        hits[k] = hits[k].saturating_add(1);
+                };
+                let a = lp.theta + n.scan.angle(i);
+                let (ex, ey) = (sx + r * a.cos() * inv, sy + r * a.sin() * inv);
+                let trav = CellTraversal::new(sx, sy, ex, ey);
+                let end = trav.end_cell();
+                for (cx, cy) in trav {
+                    if cx < 0 || cy < 0 || cx as usize >= w || cy as usize >= h {
+                        continue;
                     }
-                } else if wall > 0 && hits[k] >= wall {
-                    // a wall (or glass) that other beams ended on: this beam went through it, so the space
-                    // beyond is not known to be free from here
-                    break;
+                    let k = cy as usize * w + cx as usize;
+                    visits[k] = visits[k].saturating_add(1);
+                    if (cx, cy) == end {
+                        if hit && wall == 0 {
+                            ends[k] = ends[k].saturating_add(1);
+                        }
+                    } else if wall > 0 && hits[k] >= wall {
+                        // a wall (or glass) that other beams ended on: this beam went through it, so the space
+                        // beyond is not known to be free from here
+                        break;
+                    }
                 }
             }
         }
-    }
+        (visits, ends)
+    };
+    let add = |into: &mut [u32], from: &[u32]| into.iter_mut().zip(from).for_each(|(a, b)| *a = a.saturating_add(*b));
+    let run = nodes.len().div_ceil(rayon::current_num_threads().max(1)).max(1);
+    let (visits, ends) = nodes.par_chunks(run).map(trace).reduce_with(|(mut v, mut e), (v2, e2)| {
+        add(&mut v, &v2);
+        add(&mut e, &e2);
+        (v, e)
+    })?;
+    add(&mut hits, &ends);
     let cells: Vec<f32> = hits
         .iter()
         .zip(&visits)
