@@ -30,8 +30,9 @@ pub struct Hypotheses {
 /// A SLAM back-end: fed odometry and scans in time order, it keeps a map and a trajectory in its own map frame
 /// (the robot's pose at the first processed scan).
 ///
-/// `Send` so that the testbed can update the back-ends of several robots side by side.
-pub trait SlamBackend: Send {
+/// `Send` so that the testbed can update the back-ends of several robots side by side, `Sync` so that it can
+/// build their maps side by side.
+pub trait SlamBackend: Send + Sync {
     /// Feeds one odometry reading and the scan taken with it; errors leave the back-end unchanged.
     ///
     /// The outcome's statistics describe the update's hypotheses: a back-end that keeps one pose reports an

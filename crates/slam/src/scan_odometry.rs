@@ -27,7 +27,13 @@ use crate::tile_map::TileMap;
 use mrslam_core::{LaserScan, Pose2};
 use mrslam_core::{Xyt, pose, pose::relative};
 use serde::{Deserialize, Serialize};
+use std::cell::RefCell;
 
+thread_local! {
+    /// Each thread's matcher scratch, kept from one scan to the next (its field's buffers are derived data:
+    /// results do not depend on which a match reuses), and out of the odometry so that it stays `Sync`.
+    static SCRATCH: RefCell<Scratch> = RefCell::new(Scratch::default());
+}
 /// Smallest standard deviations (x, y metres; heading radians) of the prior on an increment: a robot
 /// that did not move by its odometry may still have moved a little.
 const MIN_PRIOR_SIGMA: [f64; 3] = [0.01, 0.01, 0.01];
@@ -117,7 +123,6 @@ pub struct ScanOdometry {
     pose: Xyt,
     /// GMapping's noise model, for the prior.
     noise: MotionModel,
-    scratch: Scratch,
     /// Scans inserted so far.
     inserted: usize,
     turn_round: bool,
@@ -153,7 +158,6 @@ impl ScanOdometry {
             last_raw: None,
             pose: Xyt { x: 0.0, y: 0.0, theta: 0.0 },
             noise,
-            scratch: Scratch::default(),
             inserted: 0,
             turn_round: so.turn_round,
             matched: 0,
@@ -218,7 +222,9 @@ impl ScanOdometry {
             sy: sy.max(MIN_PRIOR_SIGMA[1]),
             st: st.max(MIN_PRIOR_SIGMA[2]),
         };
-        let m = self.matcher.match_scan(&self.submaps[older].0, &predicted, prepared, Some(&prior), &mut self.scratch);
+        let mut scratch = SCRATCH.take();
+        let m = self.matcher.match_scan(&self.submaps[older].0, &predicted, prepared, Some(&prior), &mut scratch);
+        SCRATCH.set(scratch);
         (m.accepted && m.matched as f64 >= MIN_MATCHED_FRACTION * prepared.matched.len() as f64).then_some(m)
     }
 

@@ -9,6 +9,7 @@ use mrslam_core::{CellTraversal, LaserScan, OccupancyGrid, Odometry, Pose2};
 use mrslam_sim::{LidarModel, RobotId, Sim};
 use mrslam_slam::{Rbpf, SlamBackend};
 use nalgebra::Point2;
+use std::sync::Mutex;
 use std::time::Instant;
 
 /// A scan of one simulation step with the odometry and the true pose it was taken at.
@@ -41,7 +42,7 @@ pub(super) struct Agent<'s> {
     /// The robot explores as one of a team whose planner gives it its paths (it does not plan on its own map).
     pub coordinated: bool,
     /// The SLAM's map as last built, with the number of processed scans it was built after (see [`Agent::map`]).
-    map_cache: std::cell::RefCell<Option<(usize, OccupancyGrid)>>,
+    map_cache: Mutex<Option<(usize, OccupancyGrid)>>,
 }
 
 impl Agent<'_> {
@@ -50,7 +51,8 @@ impl Agent<'_> {
     /// call. A skipped scan changes no trajectory node, so the map of the same processed count is the same map.
     pub fn map(&self) -> Result<OccupancyGrid, RunError> {
         let version = self.processed.len();
-        let mut cache = self.map_cache.borrow_mut();
+        // a poisoned cache only means another thread panicked while building: its contents are replaced below
+        let mut cache = self.map_cache.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
         if let Some((v, map)) = cache.as_ref()
             && *v == version
         {
@@ -89,20 +91,31 @@ impl Agent<'_> {
         RunError::Slam { robot: self.setup.name.clone(), error }
     }
 
-    /// The velocity command (m/s, rad/s) of this step, from the robot's true pose (a route is driven as an
-    /// operator would, by looking at the robot) or its own map and pose (exploration is autonomous).
-    pub fn command(&mut self, true_pose: &Pose2, dt: f64) -> Result<(f64, f64), RunError> {
-        let plans = matches!(&self.controller, Controller::Explore(e) if e.wants_plan())
+    /// Plans the explorer's next path on its own map when one is due (robots of a coordinated team get theirs
+    /// from the team's planner). Independent of the other robots, so the runner plans them side by side.
+    pub fn plan_if_due(&mut self) -> Result<(), RunError> {
+        let due = matches!(&self.controller, Controller::Explore(e) if e.wants_plan())
             && !self.processed.is_empty()
             && !self.coordinated;
-        let map = if plans { Some(self.map()?) } else { None };
+        if !due {
+            return Ok(());
+        }
+        let map = self.map()?;
+        let slam_pose = self.slam.best_pose();
+        if let Controller::Explore(e) = &mut self.controller {
+            e.plan(&map, &slam_pose);
+        }
+        Ok(())
+    }
+
+    /// The velocity command (m/s, rad/s) of this step, from the robot's true pose (a route is driven as an
+    /// operator would, by looking at the robot) or its own map and pose (exploration is autonomous; the runner
+    /// makes its plan with [`Agent::plan_if_due`] first).
+    pub fn command(&mut self, true_pose: &Pose2, dt: f64) -> Result<(f64, f64), RunError> {
         match &mut self.controller {
             Controller::Waypoints(p) => Ok(p.command(true_pose, dt)),
             Controller::Explore(e) => {
                 let slam_pose = self.slam.best_pose();
-                if let Some(map) = &map {
-                    e.plan(map, &slam_pose);
-                }
                 let (front, half_width) = self.setup.model.footprint.half_extents();
                 let reach = front + Explorer::STOP_DISTANCE;
                 let blocked = self
@@ -216,7 +229,7 @@ pub(super) fn add_robots<'s>(
             slam_s: 0.0,
             observed: vec![false; truth.width() * truth.height()],
             coordinated: false,
-            map_cache: std::cell::RefCell::new(None),
+            map_cache: Mutex::new(None),
         });
     }
     Ok(agents)

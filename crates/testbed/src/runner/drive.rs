@@ -48,6 +48,9 @@ pub(super) fn drive(
         if let (Some(tm), Some(p)) = (teams.as_deref_mut(), planner.as_mut()) {
             p.plan(t, tm, agents)?;
         }
+        // Plans depend only on each robot's own map and pose: make them side by side, then command in order.
+        let plans: Vec<Result<(), RunError>> = agents.par_iter_mut().map(Agent::plan_if_due).collect();
+        plans.into_iter().collect::<Result<(), RunError>>()?;
         for a in agents.iter_mut() {
             let true_pose = sim.true_pose(a.id)?;
             if a.history.is_empty() {

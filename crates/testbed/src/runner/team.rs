@@ -19,6 +19,7 @@ use crate::scenario::{Coordination, Scenario, Success, TeamSetup};
 use mrslam_core::{CellTraversal, OccupancyGrid, Pose2};
 use mrslam_merge::{MergeParams, Merger, fuse_maps as fuse, merge};
 use nalgebra::Point2;
+use rayon::prelude::*;
 use std::collections::BTreeMap;
 use std::ops::Range;
 
@@ -44,8 +45,9 @@ pub(super) struct Snapshot {
 impl Snapshot {
     /// Takes every robot's map.
     pub(super) fn take(agents: &[Agent]) -> Result<Snapshot, RunError> {
+        // each robot's map is its own SLAM's: build them side by side
         let maps = agents
-            .iter()
+            .par_iter()
             .map(|a| {
                 if a.processed.is_empty() {
                     return Ok(None);
