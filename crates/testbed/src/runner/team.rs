@@ -7,8 +7,9 @@
 //! maps know the scenario's `min_known_m2` and, after a refused try, once one of them has grown by
 //! [`RETRY_GROWTH`]; an accepted transform joins the two teams, the host team's root frame becoming the frame of
 //! both. A team holds one map: its robots' current maps fused in the root's frame along the accepted transforms (a
-//! spanning tree: every join adds one edge between two teams). Once joined, a team's robots are taken to stay in touch (a relay through
-//! teammates): each sends its map to the team once per exchange period, and those bytes are counted too.
+//! spanning tree: every join adds one edge between two teams). Once joined, a team's robots are taken to stay in
+//! touch (a relay through teammates): each sends its map to the team once per exchange period, and those bytes are
+//! counted too.
 
 use super::agent::Agent;
 use super::coverage::Coverage;

@@ -36,6 +36,8 @@
 use crate::tile_map::{DIR_SCALE, TILE, TILE_SHIFT, TileMap, local};
 use std::cell::Cell;
 
+mod line;
+
 /// A surface element: the nearest occupied cell's mean (window-relative metres), the unit normal of the
 /// surface there (×[`NORMAL_SCALE`]), and what kind of surfel it is ([`Surfel::LINE`], [`Surfel::ORIENTED`]
 /// flags; [`Surfel::NONE`] for no surfel). 16 bytes.
@@ -170,74 +172,6 @@ struct Geometry {
     reach2: f32,
     lines: bool,
     words: usize,
-}
-
-/// An occupied cell's surfel placed in the window, for the eager reference build of the tests: the cell (window
-/// coordinates) and its mean (metres from the window's origin), the surfel, and its penalty.
-#[cfg(test)]
-#[derive(Debug, Clone, Copy)]
-struct Placed {
-    wx: i32,
-    wy: i32,
-    mx: f32,
-    my: f32,
-    surfel: Surfel,
-    penalty: f32,
-}
-
-/// The eager build's view of a window, kept as the tests' reference: its size, the reach (cells, and squared
-/// metres), the cell size.
-#[cfg(test)]
-#[derive(Debug, Clone, Copy)]
-struct Band {
-    w: i32,
-    reach: i32,
-    reach2: f32,
-    delta: f32,
-    stamp: u16,
-}
-
-#[cfg(test)]
-impl Band {
-    /// Splats `surfels` onto the window's rows from `row0` on, whose cells and best distances are `cells` and
-    /// `best`: each cell within reach of a surfel's mean keeps the nearest of each orientation class.
-    fn splat(&self, surfels: &[Placed], row0: i32, cells: &mut [[Surfel; 2]], best: &mut [[f32; 2]]) {
-        let w = self.w as usize;
-        let row1 = row0 + (cells.len() / w.max(1)) as i32 - 1;
-        let d32 = self.delta;
-        for p in surfels {
-            let s = p.surfel;
-            if s.kind & Surfel::NONE != 0 {
-                continue;
-            }
-            let (ya, yb) = ((p.wy - self.reach).max(row0), (p.wy + self.reach).min(row1));
-            if ya > yb {
-                continue;
-            }
-            let class = usize::from(s.kind & Surfel::LINE != 0 && s.ny.unsigned_abs() > s.nx.unsigned_abs());
-            let (mx, my) = (p.mx, p.my);
-            let (xa, xb) = ((p.wx - self.reach).max(0), (p.wx + self.reach).min(self.w - 1));
-            for y in ya..=yb {
-                let cy = (y as f32 + 0.5) * d32 - my;
-                let row = (y - row0) as usize * w;
-                // the row's cells within reach: |cx| <= sqrt(reach² - cy²), rounded out by a cell
-                let half = (self.reach2 - cy * cy).max(0.0).sqrt() / d32;
-                let mxc = mx / d32 - 0.5;
-                let (xa, xb) = (xa.max((mxc - half).floor() as i32), xb.min((mxc + half).ceil() as i32));
-                for x in xa..=xb {
-                    let cx = (x as f32 + 0.5) * d32 - mx;
-                    let d2 = cx * cx + cy * cy;
-                    let i = row + x as usize;
-                    let slot = &mut cells[i][class];
-                    let b = &mut best[i][class];
-                    if d2 <= self.reach2 && (slot.stamp != self.stamp || d2 + p.penalty < *b) {
-                        *b = d2 + p.penalty;
-                        *slot = s;
-                    }
-                }
-            }
-        }
-    }
 }
 
 /// Side, in cells, of the blocks in which [`Field::build_near`] decides which surfels to compute.
@@ -564,141 +498,76 @@ impl Field {
         };
         (line, 0.0)
     }
-
-    /// The line through the means of the occupied cells within [`NORMAL_RADIUS`] of padded cell (ox, oy),
-    /// weighted by their hits (up to [`LINE_WEIGHT_CAP`]), when they lie on a line: its unit normal n and
-    /// offset c (points x on the line have n·x = c).
-    ///
-    /// Fitting the line through the neighbourhood rather than through the cell's own mean matters where a
-    /// surface runs along a cell boundary: its hits then split between two rows of cells whose means lie on
-    /// either side of it, and matching each end point to its own row's mean makes a dead band in which the
-    /// pose is not observed.
-    fn line(&self, ox: i32, oy: i32, pw: i32, ph: i32, radius: i32) -> Option<(f64, f64, f64, bool)> {
-        // the neighbourhood's means and weights, the cell itself first, and their occupied indices
-        const MAX: usize = ((2 * NORMAL_RADIUS + 1) * (2 * NORMAL_RADIUS + 1)) as usize;
-        let mut pts = [(0.0f64, 0.0f64, 0.0f64); MAX];
-        let mut ids = [0u32; MAX];
-        let mut n = 0;
-        let own = self.occ[(oy * pw + ox) as usize];
-        for y in (oy - radius).max(0)..=(oy + radius).min(ph - 1) {
-            for x in (ox - radius).max(0)..=(ox + radius).min(pw - 1) {
-                let k = self.occ[(y * pw + x) as usize];
-                if k == 0 || n == MAX {
-                    continue;
-                }
-                let (_, _, mx, my, hits, _) = self.occupied[k as usize - 1];
-                let p = (mx as f64, my as f64, hits.min(LINE_WEIGHT_CAP) as f64);
-                if k == own {
-                    pts[n] = pts[0];
-                    ids[n] = ids[0];
-                    pts[0] = p;
-                    ids[0] = k;
-                } else {
-                    pts[n] = p;
-                    ids[n] = k;
-                }
-                n += 1;
-            }
-        }
-        // A clean fit (every mean within LINE_OUTLIER cells of the line) is the surface. Otherwise the
-        // neighbourhood holds another surface too (the other face of a corner, clutter): of the lines through
-        // the cell's own mean and each neighbour's, the one most means support is refitted to its supporters,
-        // so a corner's cells get the line of their own face rather than a tilted average of both.
-        let tol = LINE_OUTLIER * self.delta;
-        let (x0, y0, _) = pts[0];
-        if let Some((nx, ny, c)) = fit(&pts[..n], LINE_RATIO)
-            && pts[..n].iter().all(|&(x, y, _)| (nx * x + ny * y - c).abs() <= tol)
-        {
-            return Some(self.orient(nx, ny, c, &ids[..n]));
-        }
-        let mut best: Option<(f64, f64, f64)> = None;
-        for j in 1..n {
-            let (dx, dy) = (pts[j].0 - x0, pts[j].1 - y0);
-            let len = (dx * dx + dy * dy).sqrt();
-            if len < 0.5 * self.delta {
-                continue;
-            }
-            let (nx, ny) = (-dy / len, dx / len);
-            let support: f64 =
-                pts[..n].iter().filter(|&&(x, y, _)| (nx * (x - x0) + ny * (y - y0)).abs() <= tol).map(|p| p.2).sum();
-            if best.is_none_or(|b| support > b.0) {
-                best = Some((support, nx, ny));
-            }
-        }
-        let (_, nx, ny) = best?;
-        let mut kept = 0;
-        for i in 0..n {
-            let (x, y, _) = pts[i];
-            if (nx * (x - x0) + ny * (y - y0)).abs() <= tol {
-                pts[kept] = pts[i];
-                ids[kept] = ids[i];
-                kept += 1;
-            }
-        }
-        let (nx, ny, c) = fit(&pts[..kept], LINE_RATIO)?;
-        Some(self.orient(nx, ny, c, &ids[..kept]))
-    }
-
-    /// The line (n, c) with its normal turned towards the side the beams that hit occupied cells `ids`
-    /// (1-based) came from, when they came from one side: (nx, ny, c, oriented).
-    fn orient(&self, nx: f64, ny: f64, c: f64, ids: &[u32]) -> (f64, f64, f64, bool) {
-        let (mut along, mut total) = (0.0, 0.0);
-        for &k in ids {
-            let (_, _, _, _, hits, dir) = self.occupied[k as usize - 1];
-            along += nx * dir[0] as f64 + ny * dir[1] as f64;
-            total += hits as f64 * DIR_SCALE;
-        }
-        if along.abs() > ORIENTED_FRACTION * total && total > 0.0 {
-            // beams travel against the outward normal
-            let sg = if along > 0.0 { -1.0 } else { 1.0 };
-            (sg * nx, sg * ny, sg * c, true)
-        } else {
-            (nx, ny, c, false)
-        }
-    }
-}
-
-/// Weighted total-least-squares line through points (x, y, weight): unit normal, offset and total weight,
-/// when there are at least [`NORMAL_MIN_CELLS`] points and the scatter across the line is at most `ratio`
-/// times the scatter along it.
-fn fit(pts: &[(f64, f64, f64)], ratio: f64) -> Option<(f64, f64, f64)> {
-    if pts.len() < NORMAL_MIN_CELLS {
-        return None;
-    }
-    let (mut sw, mut sx, mut sy) = (0.0, 0.0, 0.0);
-    for &(x, y, w) in pts {
-        sw += w;
-        sx += w * x;
-        sy += w * y;
-    }
-    let (mx, my) = (sx / sw, sy / sw);
-    let (mut a, mut b, mut c) = (0.0, 0.0, 0.0);
-    for &(x, y, w) in pts {
-        let (dx, dy) = (x - mx, y - my);
-        a += w * dx * dx;
-        b += w * dx * dy;
-        c += w * dy * dy;
-    }
-    let mid = 0.5 * (a + c);
-    let rad = (0.25 * (a - c) * (a - c) + b * b).sqrt();
-    let (big, small) = (mid + rad, mid - rad);
-    if big.is_nan() || big <= 0.0 || small > ratio * big {
-        return None;
-    }
-    // the normal: the eigenvector of the small eigenvalue, from whichever row of (S - small·I) is larger
-    let (ex, ey) =
-        if (a - small).abs() + b.abs() >= (c - small).abs() + b.abs() { (-b, a - small) } else { (c - small, -b) };
-    let len = (ex * ex + ey * ey).sqrt();
-    if len.is_nan() || len <= 0.0 {
-        return None;
-    }
-    let (nx, ny) = (ex / len, ey / len);
-    Some((nx, ny, nx * mx + ny * my))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// An occupied cell's surfel placed in the window, for the eager reference build of the tests: the cell (window
+    /// coordinates) and its mean (metres from the window's origin), the surfel, and its penalty.
+    #[derive(Debug, Clone, Copy)]
+    struct Placed {
+        wx: i32,
+        wy: i32,
+        mx: f32,
+        my: f32,
+        surfel: Surfel,
+        penalty: f32,
+    }
+
+    /// The eager build's view of a window, kept as the tests' reference: its size, the reach (cells, and squared
+    /// metres), the cell size.
+    #[derive(Debug, Clone, Copy)]
+    struct Band {
+        w: i32,
+        reach: i32,
+        reach2: f32,
+        delta: f32,
+        stamp: u16,
+    }
+
+    impl Band {
+        /// Splats `surfels` onto the window's rows from `row0` on, whose cells and best distances are `cells` and
+        /// `best`: each cell within reach of a surfel's mean keeps the nearest of each orientation class.
+        fn splat(&self, surfels: &[Placed], row0: i32, cells: &mut [[Surfel; 2]], best: &mut [[f32; 2]]) {
+            let w = self.w as usize;
+            let row1 = row0 + (cells.len() / w.max(1)) as i32 - 1;
+            let d32 = self.delta;
+            for p in surfels {
+                let s = p.surfel;
+                if s.kind & Surfel::NONE != 0 {
+                    continue;
+                }
+                let (ya, yb) = ((p.wy - self.reach).max(row0), (p.wy + self.reach).min(row1));
+                if ya > yb {
+                    continue;
+                }
+                let class = usize::from(s.kind & Surfel::LINE != 0 && s.ny.unsigned_abs() > s.nx.unsigned_abs());
+                let (mx, my) = (p.mx, p.my);
+                let (xa, xb) = ((p.wx - self.reach).max(0), (p.wx + self.reach).min(self.w - 1));
+                for y in ya..=yb {
+                    let cy = (y as f32 + 0.5) * d32 - my;
+                    let row = (y - row0) as usize * w;
+                    // the row's cells within reach: |cx| <= sqrt(reach² - cy²), rounded out by a cell
+                    let half = (self.reach2 - cy * cy).max(0.0).sqrt() / d32;
+                    let mxc = mx / d32 - 0.5;
+                    let (xa, xb) = (xa.max((mxc - half).floor() as i32), xb.min((mxc + half).ceil() as i32));
+                    for x in xa..=xb {
+                        let cx = (x as f32 + 0.5) * d32 - mx;
+                        let d2 = cx * cx + cy * cy;
+                        let i = row + x as usize;
+                        let slot = &mut cells[i][class];
+                        let b = &mut best[i][class];
+                        if d2 <= self.reach2 && (slot.stamp != self.stamp || d2 + p.penalty < *b) {
+                            *b = d2 + p.penalty;
+                            *slot = s;
+                        }
+                    }
+                }
+            }
+        }
+    }
 
     #[test]
     fn a_wall_gives_line_surfels_and_seen_cells() {
