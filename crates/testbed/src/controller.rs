@@ -1,6 +1,6 @@
 //! Controllers: pure pursuit along waypoints, frontier exploration on the robot's own map, or none.
 
-use crate::frontier::frontier_path;
+use crate::frontier::{Clearance, frontier_path};
 use mrslam_core::{LaserScan, OccupancyGrid, Pose2, Xyt};
 use nalgebra::Point2;
 
@@ -161,7 +161,7 @@ impl PurePursuit {
 #[derive(Debug, Clone)]
 pub struct Explorer {
     /// Distance kept from walls when planning, metres.
-    pub clearance: f64,
+    pub clearance: Clearance,
     /// Replan period, seconds.
     pub replan_period: f64,
     /// Cruise speed, m/s.
@@ -194,16 +194,19 @@ impl Explorer {
     pub const GIVE_UP_S: f64 = 3.0;
     /// Frontiers this close to an abandoned goal are not chosen again, metres.
     pub const ABANDONED_RADIUS: f64 = 0.5;
-    /// Distance kept from walls beyond the robot's bounding radius, metres: planned paths hug obstacles at
-    /// exactly the clearance, and the follower cuts the corners of the grid path.
+    /// Distance kept from walls beyond the robot's bounding radius where there is room (the preferred
+    /// clearance), metres: the follower cuts the corners of the grid path.
     pub const MARGIN: f64 = 0.2;
+    /// Distance kept from walls beyond the robot's half width at the least (the hard clearance), metres: more
+    /// than the look-ahead check's 5 cm on each side, so that a robot squeezing through a door is not stopped.
+    pub const SQUEEZE_MARGIN: f64 = 0.1;
     /// Look-ahead of the path follower, metres (shorter than the scripted routes': frontier paths bend).
     pub const LOOKAHEAD: f64 = 0.35;
     /// Turn rate of the turn on the spot when no frontier is reachable, rad/s.
     pub const TURN_RATE: f64 = 0.5;
 
     /// An explorer driving at `speed`, keeping `clearance` from walls.
-    pub fn new(speed: f64, clearance: f64) -> Self {
+    pub fn new(speed: f64, clearance: Clearance) -> Self {
         Explorer {
             clearance,
             replan_period: 3.0,
@@ -380,7 +383,7 @@ mod tests {
             }
         }
         let start = pose(2.6, 1.0, 0.0);
-        let mut e = Explorer::new(0.3, 0.2);
+        let mut e = Explorer::new(0.3, Clearance::uniform(0.2));
         e.plan(&g, &start);
         let first = e.follower.as_ref().and_then(PurePursuit::goal).unwrap();
         assert!(first.x > 3.5, "the nearer, east alcove first: {first:?}");
@@ -407,7 +410,7 @@ mod tests {
             }
         }
         let start = pose(1.0, 1.0, 0.0);
-        let mut e = Explorer::new(0.3, 0.2);
+        let mut e = Explorer::new(0.3, Clearance::uniform(0.2));
         e.plan(&g, &start);
         assert!(e.is_turning() && !e.is_done() && !e.wants_plan());
         let dt = 0.1;
@@ -426,7 +429,7 @@ mod tests {
 
     #[test]
     fn an_explorer_follows_the_path_a_team_planner_gives_and_stops_when_told() {
-        let mut e = Explorer::new(0.3, 0.2);
+        let mut e = Explorer::new(0.3, Clearance::uniform(0.2));
         assert!(e.wants_plan() && e.goal().is_none());
         e.follow(vec![Point2::new(0.0, 0.0), Point2::new(1.0, 0.0)]);
         assert_eq!(e.goal(), Some(Point2::new(1.0, 0.0)));

@@ -2,11 +2,16 @@
 //! the lone explorer's path to its nearest frontier.
 //!
 //! A frontier cell is a free cell with at least [`FRONTIER_MIN_UNKNOWN`] unknown cells among its eight
-//! neighbours. A robot may stand on a free cell farther than its clearance from every occupied cell, or on any
-//! cell of its own disc that is not occupied (it stands there, and a lidar does not see under or behind it).
+//! neighbours. A robot may stand on a free cell farther than its hard clearance from every occupied cell, or on
+//! any cell of its own disc that is not occupied (it stands there, and a lidar does not see under or behind it).
+//! Between the hard and the preferred clearance a step costs more, as a navigation stack's inflated costmap
+//! makes it: paths keep the preferred distance from walls where there is room, and squeeze through doors where
+//! there is not.
 
 use mrslam_core::{CellState, OccupancyGrid, Pose2};
 use nalgebra::Point2;
+use std::cmp::Reverse;
+use std::collections::BinaryHeap;
 
 /// Unknown cells among a frontier cell's eight neighbours, at least.
 pub const FRONTIER_MIN_UNKNOWN: usize = 3;
@@ -16,6 +21,35 @@ pub const MIN_CLUSTER_CELLS: usize = 3;
 
 /// Spacing of the points of a planned path, metres (a path is thinned to one cell in this many metres).
 pub const PATH_SPACING: f64 = 0.4;
+
+/// Cost of a step between edge neighbours away from walls.
+const STEP_COST: u32 = 10;
+/// Extra cost of a step onto a cell at the hard clearance; it falls linearly to 0 at the preferred clearance.
+const SQUEEZE_COST: f64 = 20.0;
+
+/// How far a robot keeps from walls, metres: never nearer than `hard` (its half width and a margin, so that it
+/// fits through a door), and `preferred` where there is room (its bounding radius and a margin, so that it can
+/// turn on the spot and a path follower cutting corners does not touch walls).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Clearance {
+    /// Nearest a planned path comes to an occupied cell, metres.
+    pub hard: f64,
+    /// Distance from occupied cells beyond which a step costs no more, metres (at least `hard`).
+    pub preferred: f64,
+}
+
+impl Clearance {
+    /// One clearance, hard and preferred alike: every cell nearer a wall is out of bounds, none costs more.
+    pub fn uniform(metres: f64) -> Self {
+        Clearance { hard: metres, preferred: metres }
+    }
+
+    /// The hard and preferred radii in whole cells.
+    fn cells(&self, resolution: f64) -> (i64, i64) {
+        let hard = radius_cells(self.hard, resolution);
+        (hard, radius_cells(self.preferred, resolution).max(hard))
+    }
+}
 
 /// Squared distance of a cell with no occupied cell on the grid.
 const FAR: u32 = u32::MAX;
@@ -152,8 +186,9 @@ impl WallDistance {
     }
 }
 
-/// Where one robot can drive on a map: a breadth-first search (four neighbours, one cell a step) from its pose
-/// over the cells it may stand on, with the travel distance to every reached cell and the path to it.
+/// Where one robot can drive on a map: a cheapest-path search (Dijkstra; four neighbours, a step costing more
+/// between the hard and the preferred clearance) from its pose over the cells it may stand on, with the travel
+/// distance along the cheapest path to every reached cell and that path.
 ///
 /// The buffers are two flat arrays of the grid's size; nothing is allocated per cell.
 #[derive(Debug, Clone)]
@@ -166,10 +201,10 @@ pub struct Reach {
 }
 
 impl Reach {
-    /// Searches `map` from `pose` (the map's frame) for a robot keeping `clearance` metres from walls (`walls`:
+    /// Searches `map` from `pose` (the map's frame) for a robot keeping `clearance` from walls (`walls`:
     /// [`WallDistance::new`] of the same map); `None` when the pose is off the grid or `walls` is of another
     /// grid.
-    pub fn new(map: &OccupancyGrid, walls: &WallDistance, pose: &Pose2, clearance: f64) -> Option<Self> {
+    pub fn new(map: &OccupancyGrid, walls: &WallDistance, pose: &Pose2, clearance: Clearance) -> Option<Self> {
         Self::search(map, walls, pose, clearance, |_, _| false).map(|(reach, _)| reach)
     }
 
@@ -178,30 +213,42 @@ impl Reach {
         map: &OccupancyGrid,
         walls: &WallDistance,
         pose: &Pose2,
-        clearance: f64,
+        clearance: Clearance,
         mut stop: impl FnMut(i64, i64) -> bool,
     ) -> Option<(Self, Option<usize>)> {
         if !walls.fits(map) {
             return None;
         }
         let (w, h) = (map.width(), map.height());
-        let r = radius_cells(clearance, map.resolution());
+        let (r, preferred) = clearance.cells(map.resolution());
         let start = map.world_to_cell(&Point2::new(pose.translation.x, pose.translation.y))?;
         let (sx, sy) = (start.0 as i64, start.1 as i64);
-        let on_robot = |x: i64, y: i64| (x - sx).pow(2) + (y - sy).pow(2) <= r * r;
+        let on_robot = |x: i64, y: i64| (x - sx).pow(2) + (y - sy).pow(2) <= preferred * preferred;
+        // the cost of a step onto cell n: more the nearer a wall within the preferred clearance
+        let step_cost = |n: usize| -> u32 {
+            let d2 = walls.d2[n] as i64;
+            if preferred <= r || d2 >= preferred * preferred {
+                return STEP_COST;
+            }
+            let squeeze = ((preferred as f64 - (d2 as f64).sqrt()) / (preferred - r) as f64).clamp(0.0, 1.0);
+            STEP_COST + (SQUEEZE_COST * squeeze).round() as u32
+        };
         let cells = map.cells();
         let s = start.1 * w + start.0;
         let mut parent = vec![UNREACHED; w * h];
         let mut steps = vec![UNREACHED; w * h];
+        let mut cost = vec![u32::MAX; w * h];
         parent[s] = s as u32;
         steps[s] = 0;
-        // Every cell enters the queue once: a vector read from `head` is the FIFO queue.
-        let mut queue: Vec<u32> = vec![s as u32];
-        let mut head = 0;
+        cost[s] = 0;
+        // Cheapest first, the lower index on ties: the search does not depend on the heap's order.
+        let mut queue = BinaryHeap::from([Reverse((0u32, s as u32))]);
         let mut found = None;
-        while let Some(&c) = queue.get(head) {
-            head += 1;
+        while let Some(Reverse((k, c))) = queue.pop() {
             let c = c as usize;
+            if k > cost[c] {
+                continue;
+            }
             let (cx, cy) = ((c % w) as i64, (c / w) as i64);
             if stop(cx, cy) {
                 found = Some(c);
@@ -213,19 +260,18 @@ impl Reach {
                     continue;
                 }
                 let n = ny as usize * w + nx as usize;
-                if parent[n] != UNREACHED {
-                    continue;
-                }
                 let st = CellState::from_log_odds(cells[n]);
                 let passable = if on_robot(nx, ny) {
                     st != CellState::Occupied
                 } else {
                     st == CellState::Free && !walls.blocked(n, r)
                 };
-                if passable {
+                let kn = k + step_cost(n);
+                if passable && kn < cost[n] {
+                    cost[n] = kn;
                     parent[n] = c as u32;
                     steps[n] = steps[c] + 1;
-                    queue.push(n as u32);
+                    queue.push(Reverse((kn, n as u32)));
                 }
             }
         }
@@ -295,7 +341,7 @@ pub struct Skip<'a> {
     pub footprints: &'a [(Point2<f64>, f64)],
 }
 
-/// The frontier clusters of `map` a robot keeping `clearance` metres from walls may stand on (`walls`:
+/// The frontier clusters of `map` a robot keeping `clearance` from walls may stand on (its hard clearance; `walls`:
 /// [`WallDistance::new`] of the same map), in row-major order of their first cell.
 ///
 /// Frontier cells too close to a wall, or left out by `skip`, belong to no cluster; clusters of fewer than
@@ -303,7 +349,7 @@ pub struct Skip<'a> {
 pub fn frontiers(
     map: &OccupancyGrid,
     walls: &WallDistance,
-    clearance: f64,
+    clearance: Clearance,
     skip: &Skip<'_>,
     min_cells: usize,
 ) -> Vec<Frontier> {
@@ -312,7 +358,7 @@ pub fn frontiers(
     }
     let (w, h) = (map.width(), map.height());
     let res = map.resolution();
-    let r = radius_cells(clearance, res);
+    let (r, _) = clearance.cells(res);
     let footprints: Vec<(i64, i64, i64)> = skip
         .footprints
         .iter()
@@ -393,18 +439,18 @@ pub fn frontiers(
 ///
 /// A frontier cell is a free cell with at least [`FRONTIER_MIN_UNKNOWN`] unknown cells among its eight
 /// neighbours (the edge of unexplored space, not a one-cell hole between two far beams), outside the robot's
-/// own disc and farther than `avoid_radius` from every point of `avoid`. The disc of radius `clearance` around
+/// own disc and farther than `avoid_radius` from every point of `avoid`. The disc of the preferred clearance around
 /// the robot is passable wherever it is not occupied: the robot stands there, and a lidar does not see the
 /// cells under and behind the robot.
 pub fn frontier_path(
     map: &OccupancyGrid,
     pose: &Pose2,
-    clearance: f64,
+    clearance: Clearance,
     avoid: &[Point2<f64>],
     avoid_radius: f64,
 ) -> Option<Vec<Point2<f64>>> {
     let walls = WallDistance::new(map);
-    let r = radius_cells(clearance, map.resolution());
+    let (_, r) = clearance.cells(map.resolution());
     let (sx, sy) = map.world_to_cell_i(&Point2::new(pose.translation.x, pose.translation.y));
     let on_robot = |x: i64, y: i64| (x - sx).pow(2) + (y - sy).pow(2) <= r * r;
     let is_goal = |x: i64, y: i64| {
@@ -437,13 +483,49 @@ mod tests {
                 g.set(ix, iy, if wall { 2.0 } else { -2.0 });
             }
         }
-        let path = frontier_path(&g, &pose(1.0, 1.0, 0.0), 0.15, &[], 0.0).expect("a frontier");
+        let path = frontier_path(&g, &pose(1.0, 1.0, 0.0), Clearance::uniform(0.15), &[], 0.0).expect("a frontier");
         let end = path.last().unwrap();
         assert!(end.x > 3.9 && end.y > 0.7 && end.y < 1.3, "{end:?}");
         for iy in 15..25 {
             g.set(79, iy, 2.0);
         }
-        assert!(frontier_path(&g, &pose(1.0, 1.0, 0.0), 0.15, &[], 0.0).is_none(), "closed door: nothing to explore");
+        assert!(
+            frontier_path(&g, &pose(1.0, 1.0, 0.0), Clearance::uniform(0.15), &[], 0.0).is_none(),
+            "closed door: nothing to explore"
+        );
+    }
+
+    #[test]
+    fn a_door_narrower_than_the_preferred_clearance_is_passed_through_its_middle() {
+        // A 4 m x 3 m known room, walled, with a 0.8 m door in the east wall (y 1.1 to 1.9); unknown beyond. The
+        // Pioneer's clearances: hard 0.3 m (half its width and a margin), preferred 0.51 m (its bounding radius
+        // and a margin), which the door does not leave.
+        let mut g = grid(120, 60);
+        for iy in 0..60 {
+            for ix in 0..80 {
+                let wall = ix == 0 || iy == 0 || iy == 59 || (ix == 79 && !(22..38).contains(&iy));
+                g.set(ix, iy, if wall { 2.0 } else { -2.0 });
+            }
+        }
+        let start = pose(1.0, 0.6, 0.0);
+        let pioneer = Clearance { hard: 0.3, preferred: 0.51 };
+        assert!(frontier_path(&g, &start, Clearance::uniform(0.51), &[], 0.0).is_none(), "one clearance: blocked");
+        let path = frontier_path(&g, &start, pioneer, &[], 0.0).expect("through the door");
+        let end = path.last().unwrap();
+        assert!(end.x > 3.9 && (end.y - 1.5).abs() < 0.1, "the frontier in the door's middle: {end:?}");
+        // Away from the door the path keeps the preferred clearance: it leaves the wall the robot starts 0.6 m from
+        // no nearer, and crosses the room at least 0.51 m from every wall.
+        let walls = WallDistance::new(&g);
+        for p in path.iter().filter(|p| p.x > 0.6 && p.x < 3.4) {
+            let (ix, iy) = g.world_to_cell(p).unwrap();
+            let d = f64::from(walls.squared_cells(ix, iy).unwrap()).sqrt() * 0.05;
+            assert!(d >= 0.5, "{p:?} is {d:.2} m from a wall");
+        }
+        // And the travel distance is that of the path, not its cost.
+        let reach = Reach::new(&g, &walls, &start, pioneer).unwrap();
+        let (ex, ey) = g.world_to_cell(end).unwrap();
+        let metres = reach.distance(ex, ey).unwrap();
+        assert!((3.4..4.5).contains(&metres), "{metres} m");
     }
 
     #[test]
@@ -462,7 +544,8 @@ mod tests {
                 }
             }
         }
-        let path = frontier_path(&g, &pose(1.05, 1.0, 0.0), 0.3, &[], 0.0).expect("the unseen space behind the robot");
+        let path = frontier_path(&g, &pose(1.05, 1.0, 0.0), Clearance::uniform(0.3), &[], 0.0)
+            .expect("the unseen space behind the robot");
         let end = path.last().unwrap();
         assert!(end.x < 1.3, "it drives to the edge of the unseen space, not to the hole: {end:?}");
         // Once the space behind is seen, only the hole is left, and a hole is no frontier.
@@ -471,7 +554,7 @@ mod tests {
                 g.set(ix, iy, -2.0);
             }
         }
-        assert!(frontier_path(&g, &pose(1.05, 1.0, 0.0), 0.3, &[], 0.0).is_none());
+        assert!(frontier_path(&g, &pose(1.05, 1.0, 0.0), Clearance::uniform(0.3), &[], 0.0).is_none());
     }
 
     #[test]
@@ -485,11 +568,12 @@ mod tests {
                 g.set(ix, iy, if wall { 2.0 } else { -2.0 });
             }
         }
-        let path = frontier_path(&g, &pose(0.02, 1.0, 0.0), 0.3, &[], 0.0).expect("the corridor behind the robot");
+        let path = frontier_path(&g, &pose(0.02, 1.0, 0.0), Clearance::uniform(0.3), &[], 0.0)
+            .expect("the corridor behind the robot");
         let end = path.last().unwrap();
         assert!(end.x < 0.1, "the goal is on the west edge: {end:?}");
         let walls = WallDistance::new(&g);
-        let clusters = frontiers(&g, &walls, 0.3, &Skip::default(), MIN_CLUSTER_CELLS);
+        let clusters = frontiers(&g, &walls, Clearance::uniform(0.3), &Skip::default(), MIN_CLUSTER_CELLS);
         assert_eq!(clusters.len(), 1, "{clusters:?}");
         assert!(clusters[0].target.x < 0.1, "{clusters:?}");
     }
@@ -531,7 +615,7 @@ mod tests {
         }
         let walls = WallDistance::new(&g);
         // 0.12 m: three cells kept from walls, so the wall is passed at row 33 at the lowest.
-        let reach = Reach::new(&g, &walls, &pose(0.525, 0.525, 0.0), 0.12).unwrap();
+        let reach = Reach::new(&g, &walls, &pose(0.525, 0.525, 0.0), Clearance::uniform(0.12)).unwrap();
         assert_eq!(reach.start(), (10, 10));
         // To cell (40, 10): 20 cells east and 23 north to (30, 33), then 10 east and 23 south: 76 steps.
         let d = reach.distance(40, 10).unwrap();
@@ -547,8 +631,11 @@ mod tests {
         for w in path.windows(2) {
             assert!((w[1] - w[0]).norm() <= 0.4 + 1e-9, "thinned to 0.4 m at most: {path:?}");
         }
-        assert!(Reach::new(&g, &walls, &pose(-1.0, 0.5, 0.0), 0.12).is_none(), "off the grid");
-        assert!(Reach::new(&g, &WallDistance::new(&grid(3, 3)), &pose(0.5, 0.5, 0.0), 0.12).is_none(), "other grid");
+        assert!(Reach::new(&g, &walls, &pose(-1.0, 0.5, 0.0), Clearance::uniform(0.12)).is_none(), "off the grid");
+        assert!(
+            Reach::new(&g, &WallDistance::new(&grid(3, 3)), &pose(0.5, 0.5, 0.0), Clearance::uniform(0.12)).is_none(),
+            "other grid"
+        );
     }
 
     #[test]
@@ -565,7 +652,7 @@ mod tests {
             }
         }
         let walls = WallDistance::new(&g);
-        let all = frontiers(&g, &walls, 0.12, &Skip::default(), 1);
+        let all = frontiers(&g, &walls, Clearance::uniform(0.12), &Skip::default(), 1);
         assert_eq!(all.len(), 6, "west, east, and the hole's four sides: {all:?}");
         let west = &all[0];
         assert_eq!(west.size, 32, "rows 4 to 35: farther than three cells from the walls");
@@ -573,16 +660,16 @@ mod tests {
         assert_eq!(west.target, g.cell_center(10, 19));
         assert_eq!(all[1].cell, (89, 19));
         assert!(all[2..].iter().all(|f| f.size == 1), "{all:?}");
-        let kept = frontiers(&g, &walls, 0.12, &Skip::default(), MIN_CLUSTER_CELLS);
+        let kept = frontiers(&g, &walls, Clearance::uniform(0.12), &Skip::default(), MIN_CLUSTER_CELLS);
         assert_eq!(kept, all[..2].to_vec(), "the hole's single cells are dropped");
         let avoid = [Point2::new(0.5, 1.0)];
         let skip = Skip { avoid: &avoid, avoid_radius: 1.0, footprints: &[] };
-        let east_only = frontiers(&g, &walls, 0.12, &skip, MIN_CLUSTER_CELLS);
+        let east_only = frontiers(&g, &walls, Clearance::uniform(0.12), &skip, MIN_CLUSTER_CELLS);
         assert_eq!(east_only, all[1..2].to_vec());
         // A robot's disc of 0.3 m (six cells) round cell (88, 20) takes rows 15 to 25 off the east frontier.
         let robot = [(Point2::new(4.4, 1.0), 0.3)];
         let skip = Skip { footprints: &robot, ..Skip::default() };
-        let beside = frontiers(&g, &walls, 0.12, &skip, MIN_CLUSTER_CELLS);
+        let beside = frontiers(&g, &walls, Clearance::uniform(0.12), &skip, MIN_CLUSTER_CELLS);
         let sizes: Vec<usize> = beside.iter().map(|f| f.size).collect();
         assert_eq!(sizes, [32, 11, 10], "{beside:?}");
     }

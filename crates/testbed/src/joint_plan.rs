@@ -2,7 +2,7 @@
 //! searched once, the targets split between members by [`crate::assignment::assign`].
 
 use crate::assignment::{AssignParams, assign};
-use crate::frontier::{self, MIN_CLUSTER_CELLS, Reach, Skip, WallDistance};
+use crate::frontier::{self, Clearance, MIN_CLUSTER_CELLS, Reach, Skip, WallDistance};
 use mrslam_core::{OccupancyGrid, Pose2};
 use nalgebra::Point2;
 use rayon::prelude::*;
@@ -14,7 +14,7 @@ pub struct Member<'a> {
     /// Pose in the team map's frame.
     pub pose: Pose2,
     /// Distance kept from walls, metres (also the radius of the robot's own disc).
-    pub clearance: f64,
+    pub clearance: Clearance,
     /// Goals it gave up on (the team map's frame): frontier cells near them are no targets for it.
     pub avoid: &'a [Point2<f64>],
 }
@@ -57,8 +57,10 @@ pub struct Plan {
 /// result is the nearest reachable cluster target: the lone explorer's rule, up to the clustering.
 pub fn plan_team(map: &OccupancyGrid, members: &[Member<'_>], params: &TeamParams) -> Vec<Option<Plan>> {
     let walls = WallDistance::new(map);
-    let footprints: Vec<(Point2<f64>, f64)> =
-        members.iter().map(|m| (Point2::new(m.pose.translation.x, m.pose.translation.y), m.clearance)).collect();
+    let footprints: Vec<(Point2<f64>, f64)> = members
+        .iter()
+        .map(|m| (Point2::new(m.pose.translation.x, m.pose.translation.y), m.clearance.preferred))
+        .collect();
     // Members of the same clearance and given-up goals see the same clusters: found once for them.
     let first_alike: Vec<usize> = (0..members.len())
         .map(|i| {
@@ -133,7 +135,7 @@ mod tests {
     }
 
     fn member(x: f64, y: f64) -> Member<'static> {
-        Member { pose: pose(x, y, 0.0), clearance: 0.2, avoid: &[] }
+        Member { pose: pose(x, y, 0.0), clearance: Clearance::uniform(0.2), avoid: &[] }
     }
 
     #[test]

@@ -4,6 +4,7 @@
 use super::options::RunError;
 use super::pose_history::PoseHistory;
 use crate::controller::{Controller, Explorer, PurePursuit, blocked_ahead};
+use crate::frontier::Clearance;
 use crate::scenario::{ControllerKind, RobotSetup, Scenario};
 use mrslam_core::{CellTraversal, LaserScan, OccupancyGrid, Odometry, Pose2};
 use mrslam_sim::{LidarModel, RobotId, Sim};
@@ -207,7 +208,11 @@ pub(super) fn add_robots<'s>(
                 Controller::Waypoints(p)
             }
             ControllerKind::Explore => {
-                let clearance = r.model.footprint.bounding_radius() + Explorer::MARGIN;
+                let (_, half_width) = r.model.footprint.half_extents();
+                let clearance = Clearance {
+                    hard: half_width + Explorer::SQUEEZE_MARGIN,
+                    preferred: r.model.footprint.bounding_radius() + Explorer::MARGIN,
+                };
                 Controller::Explore(Explorer::new(r.speed, clearance))
             }
             ControllerKind::Idle => Controller::Idle,

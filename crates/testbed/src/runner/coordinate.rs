@@ -6,6 +6,7 @@ use super::options::RunError;
 use super::team::{Snapshot, Teams};
 use crate::assignment::AssignParams;
 use crate::controller::{Controller, Explorer};
+use crate::frontier::Clearance;
 use crate::joint_plan::{Member, TeamParams, plan_team};
 use crate::report::TeamPlan;
 use nalgebra::Point2;
@@ -73,7 +74,7 @@ impl Planner {
                 .map(|(&k, avoid)| {
                     let (_, place) = teams.place(k);
                     let a = &agents[k];
-                    let clearance = explorer(a).map_or(0.3, |e| e.clearance);
+                    let clearance = explorer(a).map_or(Clearance::uniform(0.3), |e| e.clearance);
                     Member { pose: place * a.slam.best_pose(), clearance, avoid }
                 })
                 .collect();
