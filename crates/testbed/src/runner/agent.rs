@@ -75,10 +75,19 @@ impl Agent<'_> {
         self.controller.is_done()
     }
 
-    /// Where the robot's current SLAM pose puts its map frame in the world (the map's pose that makes the SLAM
-    /// pose the true one): the map as seen from where the robot is now, its drift since its start left out.
+    /// Where the robot's last processed scan puts its map frame in the world (the map's pose that makes the
+    /// SLAM's pose of that scan the true one): the map as seen from where the robot is now, its drift since its
+    /// start left out. The pose of a processed scan, not the current one: between processed scans the SLAM's
+    /// pose runs on odometry alone, and a turn since the last one put the frame 2-3° off (FR079).
     pub fn frame_here(&self) -> Option<Pose2> {
-        self.fed_truth.map(|truth| truth * self.slam.best_pose().inverse())
+        let (truth, _) = self.processed.last()?;
+        let (_, pose) = self.slam.trajectory().last().copied()?;
+        Some(truth * pose.inverse())
+    }
+
+    /// The SLAM's pose of the robot's last processed scan (its map frame), if it processed one.
+    pub fn last_processed_pose(&self) -> Option<Pose2> {
+        self.slam.trajectory().last().map(|(_, pose)| *pose)
     }
 
     /// Where the robot's SLAM puts its odometry frame in its map (ROS's `map -> odom`): its best pose times

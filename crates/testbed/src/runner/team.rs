@@ -254,7 +254,7 @@ impl<'s> Teams<'s> {
             let here = |k: usize| agents[k].frame_here().map(|f| f * self.place[k].inverse());
             let contact_t = here(host).zip(here(other)).map(|(fa, fb)| fa.inv_mul(&fb));
             // Measured at the other robot, where the two maps meet, rather than at its team frame's origin.
-            let at_other = self.place[other] * agents[other].slam.best_pose();
+            let at_other = self.place[other] * agents[other].last_processed_pose().unwrap_or_default();
             let err_here = out
                 .report
                 .transform
