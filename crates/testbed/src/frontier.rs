@@ -473,16 +473,23 @@ mod tests {
         OccupancyGrid::new(w, h, 0.05, pose(0.0, 0.0, 0.0)).unwrap()
     }
 
-    #[test]
-    fn frontier_is_found_through_the_door() {
-        // A 4 m x 2 m known room, walled, with a gap in the east wall; unknown beyond.
-        let mut g = grid(120, 40);
-        for iy in 0..40 {
-            for ix in 0..80 {
-                let wall = ix == 0 || iy == 0 || iy == 39 || (ix == 79 && !(15..25).contains(&iy));
+    /// A grid of `w x h` cells whose first `room_w` columns are a known room, walled, with a door in its east
+    /// wall over rows `door`; unknown beyond.
+    fn room_with_east_door(w: usize, h: usize, room_w: usize, door: std::ops::Range<usize>) -> OccupancyGrid {
+        let mut g = grid(w, h);
+        for iy in 0..h {
+            for ix in 0..room_w {
+                let wall = ix == 0 || iy == 0 || iy == h - 1 || (ix == room_w - 1 && !door.contains(&iy));
                 g.set(ix, iy, if wall { 2.0 } else { -2.0 });
             }
         }
+        g
+    }
+
+    #[test]
+    fn frontier_is_found_through_the_door() {
+        // A 4 m x 2 m known room, walled, with a gap in the east wall; unknown beyond.
+        let mut g = room_with_east_door(120, 40, 80, 15..25);
         let path = frontier_path(&g, &pose(1.0, 1.0, 0.0), Clearance::uniform(0.15), &[], 0.0).expect("a frontier");
         let end = path.last().unwrap();
         assert!(end.x > 3.9 && end.y > 0.7 && end.y < 1.3, "{end:?}");
@@ -500,13 +507,7 @@ mod tests {
         // A 4 m x 3 m known room, walled, with a 0.8 m door in the east wall (y 1.1 to 1.9); unknown beyond. The
         // Pioneer's clearances: hard 0.3 m (half its width and a margin), preferred 0.51 m (its bounding radius
         // and a margin), which the door does not leave.
-        let mut g = grid(120, 60);
-        for iy in 0..60 {
-            for ix in 0..80 {
-                let wall = ix == 0 || iy == 0 || iy == 59 || (ix == 79 && !(22..38).contains(&iy));
-                g.set(ix, iy, if wall { 2.0 } else { -2.0 });
-            }
-        }
+        let g = room_with_east_door(120, 60, 80, 22..38);
         let start = pose(1.0, 0.6, 0.0);
         let pioneer = Clearance { hard: 0.3, preferred: 0.51 };
         assert!(frontier_path(&g, &start, Clearance::uniform(0.51), &[], 0.0).is_none(), "one clearance: blocked");
