@@ -34,6 +34,7 @@ thread_local! {
     /// results do not depend on which a match reuses), and out of the odometry so that it stays `Sync`.
     static SCRATCH: RefCell<Scratch> = RefCell::new(Scratch::default());
 }
+
 /// Smallest standard deviations (x, y metres; heading radians) of the prior on an increment: a robot
 /// that did not move by its odometry may still have moved a little.
 const MIN_PRIOR_SIGMA: [f64; 3] = [0.01, 0.01, 0.01];

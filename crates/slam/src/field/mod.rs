@@ -141,15 +141,15 @@ pub struct Field {
     seen: Vec<u64>,
     /// The padded window's and the blocks' sizes, and the build's reach.
     geometry: Geometry,
-    /// Build scratch: per cell of the padded window, 1 + index into `occupied`, or 0.
+    /// Per cell of the padded window, 1 + index into `occupied`, or 0 (filled by the build, read by lookups).
     occ: Vec<u32>,
-    /// Build scratch: the same cells' occupancy, one bit per cell, [`Geometry::words`] words a padded row
+    /// The same cells' occupancy, one bit per cell, [`Geometry::words`] words a padded row
     /// (one spare, so that a row's last bits can be read as a pair of words).
     occ_bits: Vec<u64>,
-    /// Build scratch: occupied cells of the padded window: padded x, padded y, mean (metres from the window's
+    /// The occupied cells of the padded window: padded x, padded y, mean (metres from the window's
     /// origin), hits, summed beam directions.
     occupied: Vec<(i32, i32, f32, f32, u32, [i16; 2])>,
-    /// Build scratch: per block of [`BLOCK`]² window cells, whether some lookup may need it.
+    /// Per block of [`BLOCK`]² window cells, whether some lookup may need it.
     needed: Vec<bool>,
     /// Build scratch: the points of [`Field::build_near`].
     near: Vec<(f64, f64, f64)>,

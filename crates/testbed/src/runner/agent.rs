@@ -31,8 +31,6 @@ pub(super) struct Agent<'s> {
     pub processed: Vec<(Pose2, Pose2)>,
     /// The odometry pose of the last reading fed to SLAM (its best pose is the robot's there).
     pub fed_odometry: Option<Pose2>,
-    /// The true pose of the last reading fed to SLAM.
-    pub fed_truth: Option<Pose2>,
     pub scans: usize,
     pub distance: f64,
     pub last: Pose2,
@@ -52,7 +50,7 @@ impl Agent<'_> {
     /// call. A skipped scan changes no trajectory node, so the map of the same processed count is the same map.
     pub fn map(&self) -> Result<OccupancyGrid, RunError> {
         let version = self.processed.len();
-        // a poisoned cache only means another thread panicked while building: its contents are replaced below
+        // a poisoned lock only means another thread panicked: the cache is only ever set to a whole value
         let mut cache = self.map_cache.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
         if let Some((v, map)) = cache.as_ref()
             && *v == version
@@ -81,8 +79,7 @@ impl Agent<'_> {
     /// pose runs on odometry alone, and a turn since the last one put the frame 2-3° off (FR079).
     pub fn frame_here(&self) -> Option<Pose2> {
         let (truth, _) = self.processed.last()?;
-        let (_, pose) = self.slam.trajectory().last().copied()?;
-        Some(truth * pose.inverse())
+        Some(truth * self.last_processed_pose()?.inverse())
     }
 
     /// The SLAM's pose of the robot's last processed scan (its map frame), if it processed one.
@@ -155,7 +152,6 @@ impl Agent<'_> {
             let outcome = self.slam.process(&odom, &scan).map_err(|error| self.slam_error(error))?;
             self.slam_s += t.elapsed().as_secs_f64();
             self.fed_odometry = Some(odom.pose);
-            self.fed_truth = Some(true_pose);
             if outcome.is_processed() {
                 self.processed.push((true_pose, odom.pose));
             }
@@ -235,7 +231,6 @@ pub(super) fn add_robots<'s>(
             last_scan: None,
             processed: Vec::new(),
             fed_odometry: None,
-            fed_truth: None,
             scans: 0,
             distance: 0.0,
             last: r.start,
