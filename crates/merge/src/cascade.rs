@@ -14,6 +14,7 @@
 
 use crate::alignment::{Alignment, NoAlignment};
 use crate::boundary_walls::{Boundary, BoundaryWalls};
+use crate::contact::Contact;
 use crate::correlative::{CorrelativeMerger, CorrelativeParams};
 use crate::merge_params::MergeParams;
 use crate::merger::{Merger, merge_bounded};
@@ -91,9 +92,18 @@ impl Merger for Cascade {
 
     /// Without the gate there is nothing to decide between stages: the first stage's answer that has one.
     fn align(&self, a: &OccupancyGrid, b: &OccupancyGrid) -> Result<Alignment, Box<NoAlignment>> {
+        self.align_near(a, b, None)
+    }
+
+    fn align_near(
+        &self,
+        a: &OccupancyGrid,
+        b: &OccupancyGrid,
+        contact: Option<&Contact>,
+    ) -> Result<Alignment, Box<NoAlignment>> {
         let mut last = None;
         for stage in &self.stages {
-            match stage.merger.align(a, b) {
+            match stage.merger.align_near(a, b, contact) {
                 Ok(al) => return Ok(al),
                 Err(no) => last = Some(no),
             }

@@ -42,7 +42,13 @@ pub(crate) fn check(
     let t = Instant::now();
     let agr = agreement_within(a, b, &h.transform, p.verify.wall_tolerance_cells);
     add("verify", t);
-    let mut reason = if p.verify_enabled { rejection_reason(&p.verify, h.inliers, matches, &agr) } else { None };
+    let mut reason = if p.verify_enabled {
+        // The maps' own checks first: what they say of an answer reads the same with or without a contact.
+        rejection_reason(&p.verify, h.inliers, matches, &agr)
+            .or_else(|| p.contact.and_then(|c| c.refusal(&h.transform)))
+    } else {
+        None
+    };
     let mut ambiguous = None;
     if reason.is_none() && p.verify_enabled {
         let t = Instant::now();
@@ -87,7 +93,8 @@ pub(crate) fn rival_reason(
             h.transform = refine(a, walls_b, &h.transform, &p.refine);
         }
         let apart = max_displacement(walls_b, &chosen.hypothesis.transform, &h.transform);
-        if apart <= p.verify.ambiguity_shift_m {
+        // A rival that puts robots in contact out of each other's reach is no rival.
+        if apart <= p.verify.ambiguity_shift_m || p.contact.is_some_and(|c| c.refusal(&h.transform).is_some()) {
             continue;
         }
         let agr = agreement_within(a, b, &h.transform, 1);

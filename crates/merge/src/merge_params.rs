@@ -1,6 +1,7 @@
 //! The parameters of the pipeline around an algorithm: the gate, the wall refinement, the fusion, boundary walls.
 
 use crate::boundary_walls::BoundaryWalls;
+use crate::contact::Contact;
 use crate::fuse::FusionRule;
 use crate::refine::RefineParams;
 use crate::verify::VerifyParams;
@@ -20,6 +21,11 @@ pub struct MergeParams {
     /// ([`crate::boundary_walls`]): by default those that do not mark their walls (map_server's light-grey walls,
     /// glass); `Off` is the paper's behaviour. The merged map is fused from the maps as given.
     pub boundary_walls: BoundaryWalls,
+    /// Where the two maps' robots were when they exchanged them, if they were in contact: the search keeps to
+    /// transforms that put them within reach of each other, and the gate refuses any other (None: every
+    /// transform, as for two map files).
+    #[serde(skip)]
+    pub contact: Option<Contact>,
 }
 
 impl Default for MergeParams {
@@ -30,6 +36,7 @@ impl Default for MergeParams {
             fusion: FusionRule::LogOddsSum,
             refine: RefineParams::default(),
             boundary_walls: BoundaryWalls::Unmarked,
+            contact: None,
         }
     }
 }

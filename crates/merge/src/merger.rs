@@ -1,6 +1,7 @@
 //! The merger interface and the pipeline every algorithm's answer goes through: align, refine, verify, fuse, report.
 
 use crate::boundary_walls::{Boundary, BoundaryWalls};
+use crate::contact::Contact;
 use crate::fuse::fuse;
 use crate::gate::{Checked, check, rival_reason};
 use crate::refine::wall_points;
@@ -22,6 +23,17 @@ pub trait Merger: Send + Sync {
     fn name(&self) -> &'static str;
     /// Estimates `T_a_b`, or says why it cannot.
     fn align(&self, a: &OccupancyGrid, b: &OccupancyGrid) -> Result<Alignment, Box<NoAlignment>>;
+    /// [`Merger::align`] for maps whose robots were in `contact`: an algorithm that searches may keep to the
+    /// transforms that put them within reach (the gate refuses the others whatever the algorithm does).
+    fn align_near(
+        &self,
+        a: &OccupancyGrid,
+        b: &OccupancyGrid,
+        contact: Option<&Contact>,
+    ) -> Result<Alignment, Box<NoAlignment>> {
+        let _ = contact;
+        self.align(a, b)
+    }
     /// Whether it needs both maps to mark their walls ([`crate::boundary_walls::marks_its_walls`]): [`merge`]
     /// refuses, naming the map, a pair where one does not, rather than let the algorithm take a frontier for a
     /// wall.
@@ -91,7 +103,7 @@ pub(crate) fn merge_bounded<M: Merger + ?Sized>(
         None => (None, None),
     };
     let (a, b) = (walled_a.as_ref().unwrap_or(a), walled_b.as_ref().unwrap_or(b));
-    let alignment = match merger.align(a, b) {
+    let alignment = match merger.align_near(a, b, p.contact.as_ref()) {
         Ok(al) => al,
         Err(no) => {
             let NoAlignment { reason, matches, timings_ms, evidence } = *no;

@@ -91,3 +91,34 @@ fn answers_do_not_depend_on_threads() {
         assert_eq!((again.inliers, again.matches), (first.inliers, first.matches));
     }
 }
+
+/// Robots in contact: the search keeps near where both robots were. With the true contact the answer is the one
+/// found without it; a contact that the true transform breaks (robot b 20 m away from where it was) gets no
+/// merge, not another.
+#[test]
+fn robots_in_contact_are_merged_where_they_can_have_met_and_nowhere_else() {
+    use mrslam_merge::Contact;
+    use nalgebra::{Point2, Vector2};
+    let merger = CorrelativeMerger::default();
+    for (seed, overlap) in [(1, 0.3), (2, 0.5), (3, 0.4)] {
+        let map = generate(seed, &plan());
+        let pair = cut_pair(&map, &PairSpec { overlap, max_shift_m: 4.0, rotate: true }, seed);
+        let (w, h, res) = (pair.a.width() as f64, pair.a.height() as f64, pair.a.resolution());
+        let free = pair.a.origin() * Point2::new(0.5 * w * res, 0.5 * h * res);
+        let contact = |apart: f64| Contact {
+            a: free,
+            b: pair.t_a_b.inverse() * (free + Vector2::new(apart, 0.0)),
+            within_m: 8.0,
+        };
+        let near =
+            merge(&merger, &pair.a, &pair.b, &MergeParams { contact: Some(contact(3.0)), ..MergeParams::default() });
+        let r = &near.report;
+        assert!(r.accepted, "seed {seed}: refused: {:?}", r.reason);
+        let t = r.transform.expect("an accepted merge has a transform");
+        let (deg, m) = error(t.x, t.y, t.theta, &pair.t_a_b);
+        assert!(deg < 0.5 && m < 0.1, "seed {seed}: off by {deg:.2} deg, {m:.3} m");
+        let far =
+            merge(&merger, &pair.a, &pair.b, &MergeParams { contact: Some(contact(20.0)), ..MergeParams::default() });
+        assert!(!far.report.accepted, "seed {seed}: merged out of the robots' reach: {:?}", far.report);
+    }
+}

@@ -119,7 +119,20 @@ impl CorrelativeMerger {
             for &(x, y) in points.iter() {
                 (x0, x1, y0, y1) = (x0.min(x), x1.max(x), y0.min(y), y1.max(y));
             }
-            let window = Window { x0: -x1, x1: field.width as i32 - 1 - x0, y0: -y1, y1: field.height as i32 - 1 - y0 };
+            let mut window =
+                Window { x0: -x1, x1: field.width as i32 - 1 - x0, y0: -y1, y1: field.height as i32 - 1 - y0 };
+            if let Some(c) = &self.contact {
+                let [cx0, cx1, cy0, cy1] = c.offsets(a.origin(), &scan.centroid, j as f64 * step, cell);
+                window = Window {
+                    x0: window.x0.max(cx0),
+                    x1: window.x1.min(cx1),
+                    y0: window.y0.max(cy0),
+                    y1: window.y1.min(cy1),
+                };
+                if window.x0 > window.x1 || window.y0 > window.y1 {
+                    return Vec::new();
+                }
+            }
             let mut best = Best::new(p.search.per_rotation, separation, floor);
             branch_and_bound(&pyramid, points, window, &mut best, roots);
             best.found.iter().map(|&candidate| Global { rotation: j, candidate }).collect()

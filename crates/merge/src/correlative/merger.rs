@@ -4,6 +4,7 @@ use super::bookkeeping::fail;
 use super::fine::Candidates;
 use super::params::CorrelativeMerger;
 use crate::alignment::{Alignment, Evidence, Hypothesis, NoAlignment};
+use crate::contact::Contact;
 use crate::merger::Merger;
 use crate::timing::ms;
 use crate::verify::{VerifyParams, wall_hits};
@@ -122,13 +123,23 @@ impl Merger for CorrelativeMerger {
         }
     }
 
+    fn align_near(
+        &self,
+        a: &OccupancyGrid,
+        b: &OccupancyGrid,
+        contact: Option<&Contact>,
+    ) -> Result<Alignment, Box<NoAlignment>> {
+        CorrelativeMerger { contact: contact.copied(), ..self.clone() }.align(a, b)
+    }
+
     fn align(&self, a: &OccupancyGrid, b: &OccupancyGrid) -> Result<Alignment, Box<NoAlignment>> {
         let p = &self.params;
         let mut timings = BTreeMap::new();
         let (poses, points_b) = self.answers(a, b, &mut timings).map_err(NoAnswer::into_inner)?;
         if p.answer.cross_check {
             let t = Instant::now();
-            let back = self.answers(b, a, &mut BTreeMap::new());
+            let other_way = CorrelativeMerger { contact: self.contact.map(|c| c.swapped()), ..self.clone() };
+            let back = other_way.answers(b, a, &mut BTreeMap::new());
             timings.insert("cross_check".into(), ms(t));
             if let Some(reason) = cross_check_refusal(&poses[0], &points_b, back, p.search.distinct_m) {
                 return Err(fail(reason, timings));

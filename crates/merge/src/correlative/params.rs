@@ -1,5 +1,6 @@
 //! The correlative merger's parameters, one struct per stage of the search, and the merger they configure.
 
+use crate::contact::Contact;
 use serde::{Deserialize, Serialize};
 
 /// Parameters of the correlative merger, by stage.
@@ -266,11 +267,14 @@ impl Default for AnswerParams {
 pub struct CorrelativeMerger {
     /// Its parameters.
     pub params: CorrelativeParams,
+    /// The robots' contact, when the maps come from robots in contact: the searches keep to the translations
+    /// that put them within reach ([`crate::Merger::align_near`]).
+    pub contact: Option<Contact>,
 }
 
 impl CorrelativeMerger {
     /// A merger with these parameters.
     pub fn new(params: CorrelativeParams) -> Self {
-        CorrelativeMerger { params }
+        CorrelativeMerger { params, contact: None }
     }
 }

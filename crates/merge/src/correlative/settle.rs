@@ -100,10 +100,13 @@ impl CorrelativeMerger {
         {
             return Ok(first);
         }
-        let tolerant = CorrelativeMerger::new(CorrelativeParams {
-            search: SearchParams { free_penalty: p.fallback.free_penalty, rivals: p.fallback.rivals, ..p.search },
-            ..*p
-        });
+        let tolerant = CorrelativeMerger {
+            params: CorrelativeParams {
+                search: SearchParams { free_penalty: p.fallback.free_penalty, rivals: p.fallback.rivals, ..p.search },
+                ..*p
+            },
+            contact: self.contact,
+        };
         let mut more = BTreeMap::new();
         let Ok(second) = tolerant.search(a, &cells_a, b, &pooled, &peaks, &mut more) else {
             return Ok(first);

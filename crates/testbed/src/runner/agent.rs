@@ -87,6 +87,11 @@ impl Agent<'_> {
         self.slam.trajectory().last().map(|(_, pose)| *pose)
     }
 
+    /// Where the robot's SLAM puts it now, in its map frame (its best particle's pose).
+    pub fn pose_estimate(&self) -> Pose2 {
+        self.slam.best_pose()
+    }
+
     /// Where the robot's SLAM puts its odometry frame in its map (ROS's `map -> odom`): its best pose times
     /// the inverse of the odometry pose it was fed last; `None` before its first reading.
     pub fn map_to_odom(&self) -> Option<Pose2> {

@@ -10,6 +10,10 @@
 //! spanning tree: every join adds one edge between two teams). Once joined, a team's robots are taken to stay in
 //! touch (a relay through teammates): each sends its map to the team once per exchange period, and those bytes are
 //! counted too.
+//!
+//! Robots in contact are within the range of each other, and each knows where it is on its team's map: an attempt
+//! searches only the transforms that put them that close (plus [`CONTACT_MARGIN_M`]), and the gate refuses any
+//! other ([`mrslam_merge::Contact`]; `search_near_contact = false` searches every transform, as `mrslam merge`).
 
 use super::agent::Agent;
 use super::coverage::Coverage;
@@ -18,7 +22,7 @@ use crate::eval::{map_acceptance, transform_error};
 use crate::report::{MergeAttempt, TeamPlan, TeamReport};
 use crate::scenario::{Coordination, Scenario, Success, TeamSetup};
 use mrslam_core::{CellTraversal, OccupancyGrid, Pose2};
-use mrslam_merge::{MergeParams, Merger, fuse_maps as fuse, merge};
+use mrslam_merge::{Contact, MergeParams, Merger, fuse_maps as fuse, merge};
 use nalgebra::Point2;
 use rayon::prelude::*;
 use std::collections::BTreeMap;
@@ -28,6 +32,10 @@ use std::ops::Range;
 /// try: the gate would weigh the same evidence again (robots that stand still keep meeting, and a try of two
 /// building-size maps costs 0.2-2 s).
 const RETRY_GROWTH: f64 = 0.1;
+
+/// How far two robots in contact may be apart beyond the range, metres: the error of their SLAM poses in their
+/// teams' maps (a joined team's map also carries its merges' error).
+const CONTACT_MARGIN_M: f64 = 2.0;
 
 /// Header bytes of a ROS `nav_msgs/OccupancyGrid` message (header, map metadata, array length), as serialised.
 const GRID_HEADER_BYTES: u64 = 80;
@@ -240,7 +248,14 @@ impl<'s> Teams<'s> {
                 continue;
             }
             self.bytes += message_bytes(&map_a) + message_bytes(&map_b);
-            let out = merge(self.merger.as_ref(), &map_a, &map_b, &self.params);
+            // Each robot where its team's map puts it: they are within range of each other now.
+            let at = |k: usize| Point2::from((self.place[k] * agents[k].pose_estimate()).translation.vector);
+            let contact = self.setup.search_near_contact.then(|| Contact {
+                a: at(host),
+                b: at(other),
+                within_m: self.setup.range + CONTACT_MARGIN_M,
+            });
+            let out = merge(self.merger.as_ref(), &map_a, &map_b, &MergeParams { contact, ..self.params });
             if out.report.accepted {
                 self.refused.remove(&(ra, rb));
             } else {

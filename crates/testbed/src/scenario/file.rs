@@ -156,4 +156,5 @@ pub(super) struct TeamFile {
     pub(super) coverage_period: Option<f64>,
     pub(super) beta: Option<f64>,
     pub(super) min_known_m2: Option<f64>,
+    pub(super) search_near_contact: Option<bool>,
 }

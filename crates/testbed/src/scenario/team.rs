@@ -67,6 +67,10 @@ pub struct TeamSetup {
     /// m² (0: from the first scan). Maps of a scan or two match a corridor's other doors as well as the right
     /// ones; the correlative stage asks for 100 m² of shared known space for the same reason.
     pub min_known_m2: f64,
+    /// Whether an online merge searches only the transforms that put the two robots in contact within the range
+    /// of each other (each where its SLAM puts it on its team's map); false searches every transform, as `mrslam
+    /// merge` of two files does.
+    pub search_near_contact: bool,
 }
 
 impl Default for TeamSetup {
@@ -80,6 +84,7 @@ impl Default for TeamSetup {
             coverage_period: 2.0,
             beta: 1.0,
             min_known_m2: 0.0,
+            search_near_contact: true,
         }
     }
 }
@@ -115,5 +120,6 @@ pub(super) fn resolve_team(cx: &Ctx, t: &TeamFile) -> Result<TeamSetup, Scenario
         coverage_period: positive("coverage_period", t.coverage_period, d.coverage_period)?,
         beta: non_negative("beta", t.beta, d.beta)?,
         min_known_m2: non_negative("min_known_m2", t.min_known_m2, d.min_known_m2)?,
+        search_near_contact: t.search_near_contact.unwrap_or(d.search_near_contact),
     })
 }
