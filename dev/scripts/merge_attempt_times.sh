@@ -1,13 +1,12 @@
 #!/usr/bin/env bash
-# What a merge attempt costs on robots' maps: a team scenario run for each seed, then every pair of its robots'
-# final maps merged alone by `mrslam merge` (the cascade, the gate of the online merges) with `--report`, one
-# at a time. Prints one row per pair (the stage that decided, accepted, wall time and the stages' times) and
-# the median; then the online attempts of the runs (their time in the run, where the robots' SLAMs share the
-# cores). Final maps are larger than most maps at contact (but a joined team merges its fused map).
+# What an online merge attempt costs: a team scenario run for each seed as shipped (attempts search near the
+# robots' contact) and with `search_near_contact = false` (every transform, as `mrslam merge` of two files);
+# every attempt of every run listed from report.json (time in the run, where the robots' SLAMs share the cores,
+# the stage that decided, the two teams' known areas), then the median of each variant.
 #
 # Usage: dev/scripts/merge_attempt_times.sh SCENARIO.toml OUT [SEEDS...]   (default seeds 0 1 2)
-# Uses target/debug/mrslam (the dev profile is optimised) unless MRSLAM names another binary; reuses OUT/sSEED
-# when its report.json is there.
+# Uses target/debug/mrslam (the dev profile is optimised) unless MRSLAM names another binary; reuses a run whose
+# report.json is there. Run it alone: the times are wall times.
 set -euo pipefail
 scenario=$1
 out=$2
@@ -15,42 +14,34 @@ shift 2
 seeds=("${@:-0 1 2}")
 bin=${MRSLAM:-target/debug/mrslam}
 mkdir -p "$out"
+# The variant: the same scenario beside the original (its world path is relative to it), the search unbounded.
+dir=$(dirname "$scenario")
+name=$(basename "$scenario" .toml)
+everywhere="$dir/.$name-everywhere.toml"
+trap 'rm -f "$everywhere"' EXIT
+sed 's/^\[team\]$/[team]\nsearch_near_contact = false/' "$scenario" > "$everywhere"
 for s in ${seeds[@]}; do
-  [ -f "$out/s$s/report.json" ] || "$bin" run "$scenario" --seed "$s" --out "$out/s$s" --quiet > "$out/s$s.txt"
-  robots=$(python3 -c "import json,sys; print(' '.join(sorted(json.load(open(sys.argv[1]))['robots'])))" \
-    "$out/s$s/report.json")
-  set -- $robots
-  while [ $# -gt 1 ]; do
-    a=$1
-    shift
-    for b in "$@"; do
-      "$bin" merge "$out/s$s/$a.yaml" "$out/s$s/$b.yaml" -o "$out/s$s/pair_${a}_$b.yaml" \
-        --report "$out/s$s/pair_${a}_$b.json" > /dev/null
-    done
-  done
+  [ -f "$out/near-s$s/report.json" ] || "$bin" run "$scenario" --seed "$s" --out "$out/near-s$s" --quiet > /dev/null
+  [ -f "$out/everywhere-s$s/report.json" ] || "$bin" run "$everywhere" --seed "$s" --out "$out/everywhere-s$s" --quiet > /dev/null
 done
 python3 - "$out" ${seeds[@]} <<'PY'
-import glob, json, os, statistics, sys
+import json, os, statistics, sys
 
 out, seeds = sys.argv[1], sys.argv[2:]
-print("| seed | maps | decided by | accepted | time | SIFT features (both stages) | correlative |")
-print("|---|---|---|---|---|---|---|")
-alone, online = [], []
-for s in seeds:
-    for path in sorted(glob.glob(os.path.join(out, f"s{s}", "pair_*.json"))):
-        r = json.load(open(path))
-        t = r.get("timings_ms") or {}
-        features = t.get("sift/features", 0) + t.get("sift+boundary/features", 0)
-        pair = os.path.basename(path)[5:-5].replace("_", " and ")
-        print(f"| {s} | {pair} | {r['stage']} | {r['accepted']} | {r['time_ms']:.0f} ms | "
-              f"{features:.0f} ms | {t.get('correlative', 0):.0f} ms |")
-        alone.append(r["time_ms"])
-    team = json.load(open(os.path.join(out, f"s{s}", "report.json"))).get("team") or {}
-    online += [a["time_ms"] for a in team.get("attempts", [])]
-if alone:
-    print(f"\nalone: {len(alone)} merges, median {statistics.median(alone):.0f} ms, "
-          f"range {min(alone):.0f}-{max(alone):.0f} ms")
-if online:
-    print(f"online (in the runs): {len(online)} attempts, median {statistics.median(online):.0f} ms, "
-          f"range {min(online):.0f}-{max(online):.0f} ms")
+print("| variant | seed | at | robots | known m² | decided by | accepted / correct | time in the run |")
+print("|---|---|---|---|---|---|---|---|")
+times = {"near": [], "everywhere": []}
+for variant in times:
+    for s in seeds:
+        report = json.load(open(os.path.join(out, f"{variant}-s{s}", "report.json")))
+        for a in report["team"]["attempts"]:
+            verdict = "yes / yes" if a["correct"] else ("yes / **no**" if a["accepted"] else "no")
+            known = " / ".join(f"{k:.0f}" for k in a["known_m2"])
+            print(f"| {variant} | {s} | {a['time_s']:.0f} s | {' and '.join(a['robots'])} | {known} | {a['stage']} | "
+                  f"{verdict} | {a['time_ms']:.0f} ms |")
+            times[variant].append(a["time_ms"])
+print()
+for variant, t in times.items():
+    if t:
+        print(f"{variant}: {len(t)} attempts, median {statistics.median(t):.0f} ms, range {min(t):.0f}-{max(t):.0f} ms")
 PY

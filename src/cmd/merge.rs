@@ -46,6 +46,9 @@ fn refuse_pair_only_flags(args: &MergeArgs) -> Result<()> {
     if args.matches_png.is_some() {
         bail!("--matches-png draws the matches of two maps, and {n} maps were given; merge a pair to draw it");
     }
+    if args.merger.contact.is_some() {
+        bail!("--contact places two robots, one in each of two maps, and {n} maps were given; merge a pair with it");
+    }
     if !args.viz.targets()?.is_empty() {
         bail!(
             "--rrd, --spawn and --connect record the merge of two maps, and {n} maps were given; merge a pair to record it"

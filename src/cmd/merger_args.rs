@@ -2,7 +2,8 @@
 
 use super::args::one_of;
 use clap::Args;
-use mrslam_merge::{Algorithm, BoundaryWalls, Encoding, FusionRule, MergeParams, MergerConfig, Model};
+use mrslam_merge::{Algorithm, BoundaryWalls, Contact, Encoding, FusionRule, MergeParams, MergerConfig, Model};
+use nalgebra::Point2;
 
 /// The merger and the pipeline around it, as flags.
 #[derive(Args)]
@@ -65,6 +66,12 @@ pub struct MergerArgs {
     /// Seed of the merger's random draws (the robust estimator's, the R-map's).
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
+    /// Two robots that met, `XA,YA,XB,YB,WITHIN`: robot a at (XA, YA) in map a's frame and robot b at (XB, YB)
+    /// in map b's, at most WITHIN metres apart (a radio's range, plus their pose error). The search keeps to the
+    /// transforms that put them so, and the gate refuses any other, as online merges of robots in contact do
+    /// (two maps only).
+    #[arg(long, value_name = "XA,YA,XB,YB,WITHIN", value_parser = contact, allow_hyphen_values = true)]
+    pub contact: Option<Contact>,
 }
 
 impl MergerArgs {
@@ -97,6 +104,7 @@ impl MergerArgs {
             ..MergeParams::default()
         };
         mp.verify.wall_tolerance_cells = self.wall_tolerance as usize;
+        mp.contact = self.contact;
         mp
     }
 }
@@ -107,6 +115,20 @@ fn ratio(s: &str) -> Result<f32, String> {
         Ok(r) if r > 0.0 && r <= 1.0 => Ok(r),
         Ok(r) => Err(format!("{r} is outside (0, 1]")),
         Err(e) => Err(e.to_string()),
+    }
+}
+
+/// Reads `--contact`: five finite numbers separated by commas, the last above 0.
+fn contact(s: &str) -> Result<Contact, String> {
+    let v: Vec<f64> =
+        s.split(',').map(|x| x.trim().parse::<f64>().map_err(|e| format!("`{x}`: {e}"))).collect::<Result<_, _>>()?;
+    match v[..] {
+        [xa, ya, xb, yb, within] if v.iter().all(|x| x.is_finite() && x.abs() <= 1e6) && within > 0.0 => {
+            Ok(Contact { a: Point2::new(xa, ya), b: Point2::new(xb, yb), within_m: within })
+        }
+        [_, _, _, _, within] if within <= 0.0 => Err(format!("WITHIN must be above 0 metres, got {within}")),
+        [_, _, _, _, _] => Err("the numbers must be finite metres within ±1e6".into()),
+        _ => Err(format!("expected XA,YA,XB,YB,WITHIN (five numbers), got {} number(s)", v.len())),
     }
 }
 
@@ -136,5 +158,23 @@ mod tests {
         let expected = MergerConfig { parallel: true, ..MergerConfig::new(Algorithm::Cascade, 4) };
         assert_eq!(cli.merger.config(), expected);
         assert_eq!(cli.merger.params(), MergeParams::default());
+    }
+
+    #[test]
+    fn a_contact_reads_as_five_numbers_and_nothing_else() {
+        let cli = Cli::try_parse_from(["x", "--contact", "-1.5,2,3,-4e0,12"]).unwrap();
+        let c = cli.merger.params().contact.unwrap();
+        assert_eq!((c.a, c.b, c.within_m), (Point2::new(-1.5, 2.0), Point2::new(3.0, -4.0), 12.0));
+        for (bad, says) in [
+            ("1,2,3,4", "five numbers"),
+            ("1,2,3,4,0", "above 0"),
+            ("1,2,3,4,-2", "above 0"),
+            ("1,2,nan,4,5", "finite"),
+            ("1,2,3,4,1e300", "finite"),
+            ("1,2,x,4,5", "`x`"),
+        ] {
+            let e = Cli::try_parse_from(["x", "--contact", bad]).err().unwrap().to_string();
+            assert!(e.contains(says), "{bad}: {e}");
+        }
     }
 }
