@@ -28,6 +28,7 @@ mod cdr_msg;
 mod error;
 mod format;
 mod mcap_bag;
+mod mcap_chunk;
 mod mcap_frames;
 mod mcap_writer;
 mod options;

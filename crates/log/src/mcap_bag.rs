@@ -10,8 +10,9 @@
 //! channels, messages, chunk indexes) are parsed, once their length prefixes are checked against the
 //! record ([`prefixes_fit`]): `mcap::parse_record` reserves what a string's prefix claims before reading it.
 //! A third keeps the crate from walking past an uncompressed chunk: `mcap_frames` checks its records' framing.
-//! A fourth keeps it from spinning forever on a compressed chunk that holds less than it declares: each
-//! chunk is read by a reader of its own that sees nothing past the chunk ([`read_chunk`]). A fifth keeps a
+//! A fourth keeps it from spinning forever on, or underflowing in, a compressed chunk that holds less or more
+//! than it declares: each chunk is decompressed here into at most its declared size (`mcap_chunk`) and read as
+//! an uncompressed chunk by a reader of its own that sees nothing past it ([`read_chunk`]). A fifth keeps a
 //! compressed chunk from claiming memory its bytes cannot fill: the crate reserves (and zeroes) a chunk's
 //! declared uncompressed size, and a record's claimed length within it, before it decompresses; a chunk that
 //! declares more than its compressed bytes can expand to ([`max_expansion`]) or more than the log may hold
@@ -20,6 +21,7 @@
 
 use crate::bag_messages::{BagMessages, MAX_RECORD_BYTES, Wire};
 use crate::error::LogError;
+use crate::mcap_chunk;
 use crate::mcap_frames::McapFrames;
 use mcap::records::{Record, op};
 use mcap::sans_io::linear_reader::{LinearReadEvent, LinearReader, LinearReaderOptions};
@@ -197,8 +199,22 @@ fn read_chunk(at: u64, body: &[u8], records: &mut Records) -> Result<(), LogErro
     if compressed && declared > max_bytes {
         return Err(LogError::TooLarge { path: path.clone(), limit: max_bytes, compressed: true });
     }
+    // A compressed chunk is decompressed here, into no more than it declares, and read as the uncompressed
+    // chunk it stands for (`mcap_chunk`); an uncompressed one went through `mcap_frames` as part of the file.
+    let plain;
+    let chunk = if compressed {
+        let records = &chunk[chunk.len().saturating_sub(compressed_bytes as usize)..];
+        let decompressed = mcap_chunk::decompress(compression, records, declared).map_err(|m| err(&m))?;
+        if !mcap_chunk::records_fit(&decompressed) {
+            return Err(err("a record inside it runs past its end"));
+        }
+        plain = mcap_chunk::uncompressed_chunk(chunk, &decompressed).ok_or_else(|| err("its fields are cut short"))?;
+        &plain[..]
+    } else {
+        chunk
+    };
     // No record inside a compressed chunk is longer than the chunk declares: the crate reserves what a
-    // record's length claims before it decompresses the record.
+    // record's length claims before it reads the record.
     let limit = if compressed { declared.max(chunk.len() as u64) } else { MAX_RECORD_BYTES as u64 };
     let options = LinearReaderOptions::default()
         .with_skip_start_magic(true)

@@ -168,8 +168,8 @@ fn a_chunk_that_does_not_decompress_is_refused_naming_its_offset() {
 }
 
 /// An MCAP file written by the `mcap` crate: one `compression` chunk holding a channel and 20 messages, the
-/// chunk's declared uncompressed size grown by `more` bytes; with the chunk's byte offset.
-fn mcap_chunk_declaring_more(compression: mcap::Compression, more: u64) -> (Vec<u8>, usize) {
+/// chunk's declared uncompressed size grown by `more` bytes (shrunk when negative); with the chunk's byte offset.
+fn mcap_chunk_declaring_more(compression: mcap::Compression, more: i64) -> (Vec<u8>, usize) {
     let out = std::io::Cursor::new(Vec::new());
     let mut w = mcap::WriteOptions::new().compression(Some(compression)).create(out).unwrap();
     let schema = w.add_schema("std_msgs/msg/String", "ros2msg", b"string data").unwrap();
@@ -188,22 +188,25 @@ fn mcap_chunk_declaring_more(compression: mcap::Compression, more: u64) -> (Vec<
     }
     let size = at + 9 + 16;
     let declared = u64::from_le_bytes(bytes[size..size + 8].try_into().unwrap());
-    bytes[size..size + 8].copy_from_slice(&(declared + more).to_le_bytes());
+    bytes[size..size + 8].copy_from_slice(&declared.saturating_add_signed(more).to_le_bytes());
     (bytes, at)
 }
 
 #[test]
-fn a_compressed_chunk_declaring_more_than_it_holds_is_refused_naming_its_offset() {
-    // The `mcap` crate's reader once spun forever on such a chunk (found by fuzzing): each read runs on a
+fn a_compressed_chunk_declaring_another_size_than_it_holds_is_refused_naming_its_offset() {
+    // The `mcap` crate's reader once spun forever on a chunk declaring more (found by fuzzing), and its
+    // decompression underflowed on one declaring less (found by fuzzing, 2026-12-07): each read runs on a
     // thread of its own, and one that takes long fails the test.
     let dir = tempfile::tempdir().unwrap();
-    for (name, compression) in [("zstd.mcap", mcap::Compression::Zstd), ("lz4.mcap", mcap::Compression::Lz4)] {
+    for (name, compression, codec) in
+        [("zstd.mcap", mcap::Compression::Zstd, "zstd"), ("lz4.mcap", mcap::Compression::Lz4, "lz4")]
+    {
         // As written, the file reads: it has no scan.
         let (bytes, _) = mcap_chunk_declaring_more(compression, 0);
         let path = dir.path().join(name);
         std::fs::write(&path, &bytes).unwrap();
         assert!(error(&path, &ReadOptions::default()).contains("no sensor_msgs/LaserScan topic"), "{name}");
-        for more in [1, 4096] {
+        for more in [1, 4096, -1, -1000] {
             let (bytes, at) = mcap_chunk_declaring_more(compression, more);
             std::fs::write(&path, &bytes).unwrap();
             let (done, result) = std::sync::mpsc::channel();
@@ -212,12 +215,13 @@ fn a_compressed_chunk_declaring_more_than_it_holds_is_refused_naming_its_offset(
             let e = result
                 .recv_timeout(std::time::Duration::from_secs(60))
                 .unwrap_or_else(|_| panic!("{name}, {more} more bytes declared: still reading after 60 s"));
-            let expected = format!(
-                "{}: MCAP, the chunk at byte {at}: its compressed data holds fewer bytes than the uncompressed size \
-                 it declares",
-                path.display()
-            );
+            let expected = format!("{}: MCAP, the chunk at byte {at}: its {codec} data expands to ", path.display());
             assert!(e.starts_with(&expected), "{name}, {more} more bytes declared: {e}");
+            let says = if more > 0 { "fewer than the" } else { "more than the" };
+            assert!(
+                e.contains(says) && e.contains("it declares uncompressed"),
+                "{name}, {more} more bytes declared: {e}"
+            );
         }
     }
 }
