@@ -54,6 +54,7 @@ mod loop_closure;
 mod loop_graph;
 mod map_build;
 mod motion;
+pub mod odometry_lag;
 mod outcome;
 mod params;
 mod particle;

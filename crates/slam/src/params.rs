@@ -157,6 +157,7 @@ pub const FLAT_NAMES: &[(&str, &str)] = &[
     ("scan_odometry_heading_search", "scan_odometry.heading_search"),
     ("scan_odometry_reach", "scan_odometry.reach"),
     ("scan_odometry_turn_round", "scan_odometry.turn_round"),
+    ("scan_odometry_line_lag", "scan_odometry.line_lag"),
     ("loop_closure", "loop_closure.enabled"),
     ("loop_min_travel", "loop_closure.min_travel"),
     ("loop_search_radius", "loop_closure.search_radius"),

@@ -79,6 +79,10 @@ pub struct ScanOdometryParams {
     /// fields cannot, and the prior on the logged increment then holds every match 2 × the reversed distance from
     /// the truth.
     pub turn_round: bool,
+    /// `scan_odometry_line_lag`: a log without an odometry stream (one odometry pose per scan line) has its lag
+    /// behind the scans estimated from the scans' matched heading changes and is re-timed by it
+    /// ([`crate::odometry_lag`]): a logger that wrote the last reading it had is a fraction of a scan period late.
+    pub line_lag: bool,
 }
 
 impl Default for ScanOdometryParams {
@@ -91,6 +95,7 @@ impl Default for ScanOdometryParams {
             heading_search: 0.1,
             reach: 3,
             turn_round: true,
+            line_lag: true,
         }
     }
 }
