@@ -17,7 +17,8 @@ Exit codes:
   2  `mrslam merge` only: the merge was refused (no reliable transform); no merged map is written. With three
      or more maps: some map could not be placed in the first map's frame (no chain of accepted pairs joins
      them); the maps that could are merged and written
-  130  `mrslam run` only: interrupted (Ctrl-C); the output folder's files are as before the run";
+  130  `mrslam run`, `slam`, `sim log`: interrupted (Ctrl-C; SIGTERM exits 143, SIGHUP 129): the outputs are as
+       before the command, its hidden temporary files removed";
 
 /// Multi-robot SLAM and map merging testbed: simulate, map, merge, evaluate.
 #[derive(Parser)]

@@ -27,15 +27,15 @@ pub struct ReadArgs {
     #[arg(long, default_value_t = 0.0)]
     pub scan_latency: f64,
     /// A bag's sensor_msgs/LaserScan topic (needed only when it has several).
-    #[arg(long, value_name = "TOPIC")]
+    #[arg(long, value_name = "TOPIC", allow_hyphen_values = true)]
     pub scan: Option<String>,
     /// A bag's nav_msgs/Odometry topic (needed only when it has several; without one, odometry comes from
     /// /tf).
-    #[arg(long, value_name = "TOPIC")]
+    #[arg(long, value_name = "TOPIC", allow_hyphen_values = true)]
     pub odom: Option<String>,
     /// A bag's robot frame: odometry from /tf is the odometry frame's transform to it, the laser's mount its
     /// /tf_static transform to the scan's frame (by default the frame the laser's /tf_static chain reaches).
-    #[arg(long, value_name = "NAME")]
+    #[arg(long, value_name = "NAME", allow_hyphen_values = true)]
     pub base_frame: Option<String>,
 }
 

@@ -35,9 +35,10 @@ pub enum MapCommand {
     Cut {
         /// Map YAML to cut.
         map: PathBuf,
-        /// First half (stays in the map's frame).
+        /// First half (stays in the map's frame): a map YAML, written with its PGM and a PNG preview beside it.
         a: PathBuf,
-        /// Second half (rotated and shifted; the true transform is printed).
+        /// Second half (rotated and shifted; the true transform is printed): a map YAML, written with its PGM and
+        /// a PNG preview beside it.
         b: PathBuf,
         /// Jaccard overlap of the halves' known cells; negative leaves a gap of that fraction.
         #[arg(long, default_value_t = 0.3, allow_negative_numbers = true)]
@@ -54,9 +55,30 @@ pub enum MapCommand {
 /// Fewest known cells a map must have for `map cut`.
 pub const MIN_KNOWN_TO_CUT: usize = 100;
 
-/// Reads a map YAML, printing a warning for each key map_server would ignore (a typo, most likely).
+/// Reads a map YAML, printing a warning for each key map_server would ignore (a typo, most likely). A file that
+/// is not there, a folder, or an image given where the YAML belongs is refused saying so.
 pub fn read_yaml_map(path: &Path) -> Result<OccupancyGrid> {
+    check_map_file(path)?;
+    if matches!(extension(path).as_str(), "pgm" | "png") {
+        bail!(
+            "{}: an image, where a map YAML (.yaml) was expected: the YAML gives the image its resolution and \
+             origin (`mrslam map convert {} MAP.yaml` writes one, at 0.05 m unless --resolution)",
+            path.display(),
+            path.display()
+        );
+    }
     Ok(map_io::read_ros_map_with(path, &mut |w| eprintln!("warning: {w}"))?)
+}
+
+/// Fails unless `path` is a file: not there, or a folder, is said so plainly.
+fn check_map_file(path: &Path) -> Result<()> {
+    if path.is_dir() {
+        bail!("{}: is a folder; expected a map YAML, or a PGM or PNG image", path.display());
+    }
+    if !path.exists() {
+        bail!("{}: no such file", path.display());
+    }
+    Ok(())
 }
 
 /// Runs a map subcommand.
@@ -117,8 +139,10 @@ pub fn run(cmd: MapCommand) -> Result<ExitCode> {
 
 /// Loads a map from a YAML file, or from a bare image at the given resolution.
 pub fn load_map(path: &Path, resolution: f64) -> Result<OccupancyGrid> {
-    if path.is_dir() {
-        bail!("{}: is a folder; expected a map YAML, or a PGM or PNG image", path.display());
+    check_map_file(path)?;
+    let (lo, hi) = (map_io::MIN_RESOLUTION, map_io::MAX_RESOLUTION);
+    if !(lo..=hi).contains(&resolution) {
+        bail!("--resolution {resolution:e}: must be between {lo} and {hi} metres per pixel");
     }
     match extension(path).as_str() {
         "yaml" | "yml" => read_yaml_map(path),
@@ -135,6 +159,7 @@ pub fn load_map(path: &Path, resolution: f64) -> Result<OccupancyGrid> {
             };
             grid_from_image(&img, &meta).with_context(|| format!("{}", path.display()))
         }
+        "" => bail!("{}: no file extension; expected a map YAML (.yaml), or a PGM or PNG image", path.display()),
         other => bail!("{}: unknown map format `.{other}` (expected .yaml, .pgm or .png)", path.display()),
     }
 }

@@ -18,23 +18,59 @@ pub struct Outputs<'a> {
     pub map: Option<&'a Path>,
 }
 
+/// The largest ratio between two maps' resolutions `merge` takes: a merge resamples both maps to one resolution,
+/// and maps further apart than this are a wrong file (or a typo'd resolution), not two robots' maps.
+pub const MAX_RESOLUTION_RATIO: f64 = 20.0;
+
 /// Refuses a map given twice among `files` (their maps `maps`, in order): by name, by another path to the same
-/// file, or as a copy holding the same cells. Merging a map with itself measures nothing.
+/// file, as two YAMLs naming one image, or as a copy holding the same cells (wherever its origin puts them).
+/// Merging a map with itself measures nothing. Also refuses two maps whose resolutions are further apart than
+/// [`MAX_RESOLUTION_RATIO`].
 pub fn refuse_same_maps(files: &[&Path], maps: &[&OccupancyGrid]) -> Result<()> {
     for (i, (fa, a)) in files.iter().zip(maps).enumerate() {
         for (fb, b) in files.iter().zip(maps).skip(i + 1) {
-            let same_file = fa.canonicalize().ok().is_some_and(|p| fb.canonicalize().ok() == Some(p));
-            if same_file {
-                anyhow::bail!("{} and {}: the same map file given twice", fa.display(), fb.display());
-            }
-            if a == b {
-                anyhow::bail!(
-                    "{} holds the same map as {} (a copy?): merging a map with itself measures nothing",
-                    fb.display(),
-                    fa.display()
-                );
-            }
+            refuse_same_pair(fa, a, fb, b)?;
+            refuse_far_resolutions(fa, a, fb, b)?;
         }
+    }
+    Ok(())
+}
+
+/// Refuses `a` (read from `fa`) and `b` (from `fb`) when they are one map: one file, one image, or the same cells.
+fn refuse_same_pair(fa: &Path, a: &OccupancyGrid, fb: &Path, b: &OccupancyGrid) -> Result<()> {
+    let same_file = fa.canonicalize().ok().is_some_and(|p| fb.canonicalize().ok() == Some(p));
+    if same_file {
+        anyhow::bail!("{} and {}: the same map file given twice", fa.display(), fb.display());
+    }
+    let image = |f: &Path| super::paths::read_files(f).get(1).and_then(|i| i.canonicalize().ok());
+    if let Some(shared) = image(fa).filter(|i| image(fb).as_ref() == Some(i)) {
+        anyhow::bail!(
+            "{} and {} both name the image {}: merging a map with itself measures nothing",
+            fa.display(),
+            fb.display(),
+            shared.display()
+        );
+    }
+    if a.width() == b.width() && a.height() == b.height() && a.cells() == b.cells() {
+        anyhow::bail!(
+            "{} holds the same cells as {} (a copy?): merging a map with itself measures nothing",
+            fb.display(),
+            fa.display()
+        );
+    }
+    Ok(())
+}
+
+/// Refuses two maps whose resolutions differ by more than [`MAX_RESOLUTION_RATIO`].
+fn refuse_far_resolutions(fa: &Path, a: &OccupancyGrid, fb: &Path, b: &OccupancyGrid) -> Result<()> {
+    let (ra, rb) = (a.resolution(), b.resolution());
+    if ra.max(rb) > MAX_RESOLUTION_RATIO * ra.min(rb) {
+        anyhow::bail!(
+            "{} ({ra} m per pixel) and {} ({rb} m per pixel): resolutions more than {MAX_RESOLUTION_RATIO}x apart \
+             are not two robots' maps of one place; check the files' `resolution`",
+            fa.display(),
+            fb.display()
+        );
     }
     Ok(())
 }

@@ -8,6 +8,10 @@ use std::path::{Path, PathBuf};
 /// Fails unless a file can be written at `path` (its folder exists, no folder in the way): checked before
 /// long work, so that a typo in an output path costs nothing and no result is computed only to be lost.
 pub fn check_output(path: &Path) -> Result<()> {
+    // A map YAML names its image by text; a name that is not text cannot be written into it, nor shown.
+    if path.file_name().is_some_and(|n| n.to_str().is_none()) {
+        bail!("{}: cannot write there: the file name is not UTF-8 text; rename it", path.display());
+    }
     if path.is_dir() {
         bail!("{}: cannot write there: it is a folder", path.display());
     }
@@ -17,6 +21,16 @@ pub fn check_output(path: &Path) -> Result<()> {
         bail!("{}: cannot write there: folder {} does not exist", path.display(), dir.display());
     }
     Ok(())
+}
+
+/// Makes the output folder `dir` (given to `--out`) when it is not there: its parent must exist, as every
+/// output's folder must ([`check_output`]), so a typo in `--out` makes no chain of folders.
+pub fn create_out_folder(dir: &Path) -> Result<()> {
+    if dir.is_dir() {
+        return Ok(());
+    }
+    check_output(dir).map_err(|e| anyhow::anyhow!("--out {e}"))?;
+    std::fs::create_dir(dir).map_err(|e| anyhow::anyhow!("--out {}: cannot create output folder: {e}", dir.display()))
 }
 
 /// The lower-case extension of `path` (empty when it has none).
@@ -105,5 +119,14 @@ mod tests {
         assert!(check_not_input(&dir.path().join("other.yaml"), &[&yaml]).is_ok());
         assert!(check_extension(Path::new("willow"), "OUT", &["yaml"]).is_err());
         Ok(())
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn an_output_name_that_is_not_text_is_refused() {
+        use std::os::unix::ffi::OsStrExt;
+        let name = std::ffi::OsStr::from_bytes(b"y\xff.yaml");
+        let e = check_output(Path::new(name)).unwrap_err().to_string();
+        assert!(e.contains("not UTF-8"), "{e}");
     }
 }

@@ -19,7 +19,8 @@ pub struct RunArgs {
     pub scenario: PathBuf,
     /// Output folder (default: out/NAME, NAME being the scenario's name; a folder given here is made when its
     /// parent exists). A run replaces or removes only the files an earlier run wrote there (listed in its
-    /// run-files.txt), and never a file the scenario reads.
+    /// run-files.txt, and of the names a run writes), and never a file the scenario reads; a file of its output
+    /// names that no run-files.txt lists is refused unless --force.
     #[arg(long)]
     pub out: Option<PathBuf>,
     /// Merge algorithm to run instead of the scenario's: one name, or `all` to compare them on the same maps.
@@ -33,6 +34,10 @@ pub struct RunArgs {
     /// merged map (/merged_map).
     #[arg(long, value_name = "OUT.mcap")]
     pub mcap: Option<PathBuf>,
+    /// Replace files of the run's output names in --out that no earlier run lists in run-files.txt (your own
+    /// files of those names, or a run's from before run-files.txt); without it the run refuses to start.
+    #[arg(long)]
+    pub force: bool,
     /// No progress bar.
     #[arg(long)]
     pub quiet: bool,
@@ -66,23 +71,31 @@ pub fn run(args: RunArgs) -> Result<ExitCode> {
             .into_iter()
             .filter_map(|(flag, path, kind)| path.map(|p| (flag, p, kind)))
             .collect();
-    let folder = RunFolder::prepare(&out_dir, args.out.is_none(), files, &own, &inputs)?;
+    let folder = RunFolder::prepare(&out_dir, args.out.is_none(), files, &own, &inputs, args.force)?;
     let mut bag = args.mcap.as_deref().map(|p| RunBag::create(p, &scenario)).transpose()?;
     // The same for the recording: a file that cannot be written, or no viewer, fails here.
     let recording_id = format!("{}-seed{}", scenario.name, scenario.seed);
     let name = format!("{} (seed {})", scenario.name, scenario.seed);
     let mut viz = args.viz.open(&recording_id, &name)?.map(RunRecorder::new);
-    // Ctrl-C from here: the folder's files are as they were (this run's are moved there only at the end).
-    super::interrupt::on_ctrl_c(format!(
-        "mrslam run: interrupted: the outputs of {} are as they were before this run (an earlier run's, if any){}",
-        out_dir.display(),
-        args.viz
-            .rrd
-            .as_deref()
-            .map(|r| format!("; the recording so far, without its footer: {}", mrslam_viz::partial_path(r).display()))
-            .unwrap_or_default()
-            + &bag.as_ref().map(RunBag::interrupted).unwrap_or_default()
-    ));
+    // Ctrl-C (or SIGTERM, SIGHUP) from here: the folder's files are as they were (this run's are moved there only
+    // at the end), and the bag's hidden temporary file goes.
+    super::interrupt::on_interrupt(
+        format!(
+            "mrslam run: interrupted: the outputs of {} are as they were before this run (an earlier run's, if \
+             any){}{}",
+            out_dir.display(),
+            args.viz
+                .rrd
+                .as_deref()
+                .map(|r| format!(
+                    "; the recording so far, without its footer: {}",
+                    mrslam_viz::partial_path(r).display()
+                ))
+                .unwrap_or_default(),
+            args.mcap.as_deref().map(|m| format!("; no bag written to {}", m.display())).unwrap_or_default()
+        ),
+        bag.iter().map(|b| b.temporary().to_path_buf()).collect(),
+    );
     let bar = super::sim_progress::bar(&scenario.name, scenario.duration, args.quiet);
     let opts = RunOptions {
         algorithms,
@@ -99,9 +112,9 @@ pub fn run(args: RunArgs) -> Result<ExitCode> {
         let removed = folder.commit(|staging| Ok(write_outputs(&out, staging)?))?;
         Ok::<_, anyhow::Error>((removed, bag.map(|b| b.commit()).transpose()?))
     });
-    if interrupted {
+    if let Some(code) = interrupted {
         eprintln!("mrslam run: interrupted; the outputs were moved into place first ({})", out_dir.display());
-        return Ok(ExitCode::from(130));
+        return Ok(ExitCode::from(code));
     }
     let (removed, bag) = removed?;
     for r in removed {

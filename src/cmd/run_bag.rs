@@ -38,9 +38,9 @@ impl RunBag {
         Ok(Self { path: path.to_path_buf(), partial, writer, error: None })
     }
 
-    /// What an interruption leaves: the bag so far under its temporary name, without its summary.
-    pub fn interrupted(&self) -> String {
-        format!("; the bag so far, without its summary and indexes: {}", self.partial.display())
+    /// The hidden name the bag is written under until it is complete: removed on an interruption.
+    pub fn temporary(&self) -> &Path {
+        &self.partial
     }
 
     /// Writes what robot `s.robot` did in a step: its SLAM's `map -> odom` (as it stood before the step's

@@ -1,8 +1,10 @@
 //! A run's output folder. The files a run will write there are checked by the one output rule before the run;
 //! they are written into a staging folder inside it and moved into place at the end, so an interrupted run
 //! leaves the folder as it was. The files an earlier run wrote there and this one does not are then removed:
-//! only those, as listed in the folder's [`MANIFEST`] or named as this run's outputs; a run removes nothing it
-//! did not make.
+//! only those, as listed in the folder's [`MANIFEST`] or named as this run's outputs, and only names a run writes
+//! (maps with their images and previews, pictures, `report.json`, recordings and bags): a run removes nothing it
+//! did not make. A file of this run's output names already in the folder that no manifest lists (the user's own,
+//! or a run's from before manifests) is not overwritten unless asked (`--force`).
 
 use super::paths::written_files;
 use super::{Outputs, kind};
@@ -20,6 +22,17 @@ pub struct RunFolder {
     files: Vec<PathBuf>,
     /// The run's own files given by their own flags (`--rrd`, `--mcap`), written in place, not staged.
     own: Vec<PathBuf>,
+    /// The files the scenario reads: never removed, whatever a manifest says.
+    inputs: Vec<PathBuf>,
+}
+
+/// The extensions of the files a run writes into its folder (maps, their images and previews, overlay pictures,
+/// recordings, bags); with `report.json`, the only names a manifest may make a run remove.
+const RUN_EXTENSIONS: &[&str] = &["yaml", "pgm", "png", "rrd", "mcap"];
+
+/// Whether a run could have written a file called `name` into its folder.
+fn a_runs_name(name: &str) -> bool {
+    name == "report.json" || RUN_EXTENSIONS.contains(&super::paths::extension(Path::new(name)).as_str())
 }
 
 /// A file of a run given by its own flag: the flag, the file, the kind of file it must be.
@@ -29,13 +42,15 @@ impl RunFolder {
     /// Makes `dir` when it is not there (its parent must exist unless `make_parents`: a typo in `--out` makes
     /// no chain of folders), then checks `files` (the run's outputs in `dir`) and the files given by their own
     /// flags (`own`: a recording, a bag) by the one output rule against `inputs`. A folder made here is removed
-    /// again when the check fails.
+    /// again when the check fails. Unless `force`, a file of `files` already in `dir` that no manifest lists is
+    /// refused: a run replaces only what a run wrote.
     pub fn prepare(
         dir: &Path,
         make_parents: bool,
         files: Vec<PathBuf>,
         own: &[OwnOutput<'_>],
         inputs: &[PathBuf],
+        force: bool,
     ) -> Result<RunFolder> {
         let made = !dir.exists();
         if dir.exists() && !dir.is_dir() {
@@ -65,8 +80,11 @@ impl RunFolder {
             }
             return Err(e);
         }
+        if !force {
+            refuse_unlisted(dir, &files)?;
+        }
         let own = own.iter().map(|(_, p, _)| p.to_path_buf()).collect();
-        Ok(RunFolder { dir: dir.to_path_buf(), files, own })
+        Ok(RunFolder { dir: dir.to_path_buf(), files, own, inputs: inputs.to_vec() })
     }
 
     /// Calls `write` on a staging folder inside the run's folder, moves what it wrote into place, removes the
@@ -85,9 +103,12 @@ impl RunFolder {
             written.extend(plain_name(r));
         }
         let mut removed = Vec::new();
-        for name in earlier.difference(&written) {
+        let resolved_inputs: Vec<PathBuf> = self.inputs.iter().filter_map(|i| i.canonicalize().ok()).collect();
+        let ours: BTreeSet<String> = self.files.iter().filter_map(|f| plain_name(f)).collect();
+        for name in earlier.difference(&written).filter(|n| ours.contains(*n) || a_runs_name(n)) {
             let path = self.dir.join(name);
-            if path.is_file() {
+            let an_input = path.canonicalize().is_ok_and(|c| resolved_inputs.contains(&c));
+            if path.is_file() && !an_input {
                 std::fs::remove_file(&path).with_context(|| format!("{}: cannot remove", path.display()))?;
                 removed.push(path);
             }
@@ -122,17 +143,37 @@ impl RunFolder {
         Ok(names)
     }
 
-    /// The names in the folder's [`MANIFEST`] (none when there is none): plain file names only, so that an
-    /// edited manifest cannot point outside the folder.
+    /// The names in the folder's [`MANIFEST`].
     fn manifest(&self) -> BTreeSet<String> {
-        let text = std::fs::read_to_string(self.dir.join(MANIFEST)).unwrap_or_default();
-        text.lines()
-            .map(str::trim)
-            .filter(|l| !l.is_empty() && !l.starts_with('#'))
-            .filter(|l| Path::new(l).file_name().is_some_and(|f| f == *l) && *l != MANIFEST)
-            .map(str::to_string)
-            .collect()
+        listed(&self.dir)
     }
+}
+
+/// The names in `dir`'s [`MANIFEST`] (none when there is none): plain file names only, so that an edited
+/// manifest cannot point outside the folder.
+fn listed(dir: &Path) -> BTreeSet<String> {
+    let text = std::fs::read_to_string(dir.join(MANIFEST)).unwrap_or_default();
+    text.lines()
+        .map(str::trim)
+        .filter(|l| !l.is_empty() && !l.starts_with('#'))
+        .filter(|l| Path::new(l).file_name().is_some_and(|f| f == *l) && *l != MANIFEST)
+        .map(str::to_string)
+        .collect()
+}
+
+/// Fails, naming the first, when a file of `files` is already in `dir` and no manifest there lists it.
+fn refuse_unlisted(dir: &Path, files: &[PathBuf]) -> Result<()> {
+    let listed = listed(dir);
+    let unlisted = files.iter().filter(|f| f.is_file()).find(|f| plain_name(f).is_none_or(|n| !listed.contains(&n)));
+    if let Some(f) = unlisted {
+        bail!(
+            "--out {}: {} is there and no earlier run lists it in {MANIFEST} (a file of your own, or a run's from \
+             before {MANIFEST} existed): refusing to overwrite it; move it away, or --force to replace it",
+            dir.display(),
+            f.display()
+        );
+    }
+    Ok(())
 }
 
 /// The file name of `path` as text, when it has one.
@@ -149,7 +190,7 @@ mod tests {
         let dir = tempfile::tempdir()?;
         let d = dir.path();
         let files = vec![d.join("a.json"), d.join("b.json")];
-        let folder = RunFolder::prepare(d, false, files.clone(), &[], &[])?;
+        let folder = RunFolder::prepare(d, false, files.clone(), &[], &[], false)?;
         folder.commit(|s| {
             std::fs::write(s.join("a.json"), "1")?;
             std::fs::write(s.join("b.json"), "1")?;
@@ -172,10 +213,43 @@ mod tests {
     }
 
     #[test]
+    fn a_run_overwrites_no_unlisted_file_and_removes_only_names_a_run_writes() -> Result<()> {
+        let dir = tempfile::tempdir()?;
+        let d = dir.path();
+        std::fs::write(d.join("experia.yaml"), "the user's own")?;
+        std::fs::write(d.join("report.json"), "the user's own")?;
+        let files = vec![d.join("experia.yaml"), d.join("report.json")];
+        let e = RunFolder::prepare(d, false, files.clone(), &[], &[], false).err().map(|e| e.to_string());
+        let e = e.unwrap_or_default();
+        assert!(e.contains("experia.yaml is there") && e.contains("run-files.txt") && e.contains("--force"), "{e}");
+        assert_eq!(std::fs::read_to_string(d.join("experia.yaml"))?, "the user's own");
+        // With --force the run replaces them and lists them; then a manifest with a hand-added name removes only
+        // what a run could have written.
+        let folder = RunFolder::prepare(d, false, files.clone(), &[], &[], true)?;
+        folder.commit(|s| {
+            std::fs::write(s.join("experia.yaml"), "1")?;
+            Ok(std::fs::write(s.join("report.json"), "1")?)
+        })?;
+        let manifest = std::fs::read_to_string(d.join(MANIFEST))?;
+        std::fs::write(d.join(MANIFEST), format!("{manifest}notes.txt\nold.rrd\n"))?;
+        std::fs::write(d.join("notes.txt"), "the user's notes")?;
+        std::fs::write(d.join("old.rrd"), "an earlier run's recording")?;
+        let folder = RunFolder::prepare(d, false, files, &[], &[], false)?;
+        let removed = folder.commit(|s| {
+            std::fs::write(s.join("experia.yaml"), "2")?;
+            Ok(std::fs::write(s.join("report.json"), "2")?)
+        })?;
+        assert_eq!(removed, vec![d.join("old.rrd")]);
+        assert_eq!(std::fs::read_to_string(d.join("notes.txt"))?, "the user's notes");
+        Ok(())
+    }
+
+    #[test]
     fn a_missing_parent_is_refused_and_an_output_over_an_input_removes_the_folder_it_made() -> Result<()> {
         let dir = tempfile::tempdir()?;
         let deep = dir.path().join("missing/deep");
-        let e = RunFolder::prepare(&deep, false, vec![], &[], &[]).err().map(|e| e.to_string()).unwrap_or_default();
+        let e =
+            RunFolder::prepare(&deep, false, vec![], &[], &[], false).err().map(|e| e.to_string()).unwrap_or_default();
         assert!(e.contains("does not exist"), "{e}");
         assert!(!dir.path().join("missing").exists());
         let input = dir.path().join("in.rrd");
@@ -187,6 +261,7 @@ mod tests {
             vec![fresh.join("x.json")],
             &[("--rrd", &input, kind::RRD)],
             std::slice::from_ref(&input),
+            false,
         )
         .err()
         .map(|e| e.to_string())

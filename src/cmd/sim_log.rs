@@ -78,8 +78,7 @@ pub fn run(args: LogArgs) -> Result<ExitCode> {
     if let Some(s) = args.seed {
         scenario.seed = s;
     }
-    std::fs::create_dir_all(&args.out)
-        .map_err(|e| anyhow::anyhow!("{}: cannot create output folder: {e}", args.out.display()))?;
+    super::paths::create_out_folder(&args.out)?;
     let summary_path = args.out.join("log.json");
     let mut outputs = vec![summary_path.clone()];
     for r in &scenario.robots {
@@ -94,6 +93,7 @@ pub fn run(args: LogArgs) -> Result<ExitCode> {
         .check()?;
     let mut bag = args.mcap.as_deref().map(|p| RunBag::create(p, &scenario)).transpose()?;
     let mut logs = Vec::new();
+    let mut temporary: Vec<PathBuf> = bag.iter().map(|b| b.temporary().to_path_buf()).collect();
     for r in &scenario.robots {
         let [clf, ..] = robot_files(&args.out, &r.name);
         let header = format!(
@@ -106,6 +106,7 @@ pub fn run(args: LogArgs) -> Result<ExitCode> {
             r.name
         );
         let file = AtomicFile::create(&clf)?;
+        temporary.push(file.temporary_path().to_path_buf());
         let writer = CarmenWriter::new(file, &header).with_context(|| clf.display().to_string())?;
         logs.push(RobotLog {
             name: r.name.clone(),
@@ -116,6 +117,14 @@ pub fn run(args: LogArgs) -> Result<ExitCode> {
             history: PoseHistory::default(),
         });
     }
+    // Ctrl-C (or SIGTERM, SIGHUP): the logs and the bag being written are hidden temporary files; they go.
+    super::interrupt::on_interrupt(
+        format!(
+            "mrslam sim log: interrupted: the logs (and bag) being written into {} were removed",
+            args.out.display()
+        ),
+        temporary,
+    );
     let bar = super::sim_progress::bar(&scenario.name, scenario.duration, args.quiet);
     let mut write_error: Option<anyhow::Error> = None;
     let odom_lines = !args.no_odom_lines;

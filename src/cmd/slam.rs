@@ -11,10 +11,10 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use mrslam_core::map_io;
 use mrslam_core::output::write_file_atomic;
 use mrslam_core::relations::{self, StampedPose};
-use mrslam_core::{Odometry, Pose2};
+use mrslam_core::{LaserScan, Odometry, Pose2};
 use mrslam_log::{MAX_SPEED, MAX_TURN_RATE, faster_than_a_robot};
 use mrslam_slam::synthetic::{Drift, inject_drift};
-use mrslam_slam::{LogRun, LogRunError, Preset, Rbpf, map_log};
+use mrslam_slam::{LogRun, LogRunError, Preset, Rbpf, map_log, odometry_lag};
 use mrslam_viz::{Level, ProcessedScan, RelationMark, SlamLogRecorder};
 use nalgebra::Point2;
 use serde_json::json;
@@ -142,6 +142,21 @@ impl DriftArgs {
     }
 }
 
+/// Refuses a map resolution (`map.delta`, set through `flag`) the map reader would refuse, so that no run ends
+/// in a map no command can read.
+pub fn check_map_resolution(flag: &str, params: &mrslam_slam::SlamParams) -> Result<()> {
+    let delta = params.map.delta;
+    if !(map_io::MIN_RESOLUTION..=map_io::MAX_RESOLUTION).contains(&delta) {
+        bail!(
+            "{flag} map.delta={delta}: the map's resolution must be between {} and {} metres per pixel (the map \
+             reader's bounds)",
+            map_io::MIN_RESOLUTION,
+            map_io::MAX_RESOLUTION
+        );
+    }
+    Ok(())
+}
+
 /// Runs `mrslam slam`.
 pub fn run(args: SlamArgs) -> Result<ExitCode> {
     super::Outputs::reading(std::iter::once(args.log.as_path()).chain(args.relations.as_deref()))
@@ -169,6 +184,7 @@ pub fn run(args: SlamArgs) -> Result<ExitCode> {
     }
     super::args::set_each("--set", &args.set, |name, value| params.set(name, value))?;
     params.validate().map_err(|e| anyhow::anyhow!("slam parameters: {e}"))?;
+    check_map_resolution("--set", &params)?;
     // Read the relations before the long work, so that a bad file costs nothing.
     let rels = match &args.relations {
         Some(p) => Some(relations::read_relations(p)?),
@@ -180,8 +196,14 @@ pub fn run(args: SlamArgs) -> Result<ExitCode> {
     }
     let mut odo: Vec<Odometry> = log.scans.iter().map(|r| r.odometry).collect();
     args.drift.inject(&mut odo, args.seed);
-
+    // Jumps as the log's lines have them, before the re-timing below blends each scan's with the next's.
     let jumps = odometry_jumps(&odo, &log.scans);
+    let scans: Vec<&LaserScan> = log.scans.iter().map(|r| &r.scan).collect();
+    let lag = if log.odometry.is_empty() {
+        odometry_lag::retime_line_odometry(&mut odo, &scans, &params, log.scans[0].laser_offset)
+    } else {
+        None
+    };
 
     let gate = super::slam_eta::Gate {
         linear: params.filter.linear_update,
@@ -196,6 +218,8 @@ pub fn run(args: SlamArgs) -> Result<ExitCode> {
         .viz
         .open(&format!("slam-{name}-{}-seed{}", args.preset, args.seed), &format!("slam {name}"))?
         .map(|rec| SlamLogRecorder::new(rec, &name));
+    // Ctrl-C (or SIGTERM, SIGHUP): nothing is written before the end, but the recording so far.
+    super::interrupt::on_interrupt(interrupted_message(&args), Vec::new());
     let stamp0 = log.scans[0].scan.stamp;
     let bar = ProgressBar::new(log.scans.len() as u64);
     if args.quiet || !std::io::stderr().is_terminal() {
@@ -315,6 +339,20 @@ pub fn run(args: SlamArgs) -> Result<ExitCode> {
     let mem = filter.memory_stats();
     println!("log: {} ({:.1} s); {}", args.log.display(), duration, log.repairs.describe());
     println!("odometry: {}", log.repairs.describe_odometry());
+    if let Some(l) = &lag {
+        let verdict = match (l.applies(), l.lag_s > 0.0) {
+            (true, true) => format!("the scan lines' odometry is {:.3} s late; re-timed", l.lag_s),
+            (true, false) => format!("the scan lines' odometry is {:.3} s early; re-timed", -l.lag_s),
+            (false, _) => "none worth re-timing the scan lines' odometry by".to_string(),
+        };
+        println!(
+            "odometry lag: {verdict} (the best lag, {:+.3} s, leaves {:.0} % of the squared heading misfit of {} \
+             matched scan pairs)",
+            l.lag_s,
+            100.0 * l.residual_ratio,
+            l.pairs
+        );
+    }
     if let Some(worst) = jumps.iter().max_by(|a, b| a.distance.total_cmp(&b.distance)) {
         println!(
             "warning: the odometry jumps {} times (faster than {MAX_SPEED} m/s or {MAX_TURN_RATE} rad/s between scans; \
@@ -415,6 +453,9 @@ pub fn run(args: SlamArgs) -> Result<ExitCode> {
                 "odometry_stamped_in_bursts": r.stamped_in_bursts,
             },
             "odometry_jumps": jumps.len(),
+            "line_odometry_lag": lag.map(|l| json!({
+                "lag_s": l.lag_s, "pairs": l.pairs, "residual_ratio": l.residual_ratio, "applied": l.applies()
+            })),
             "scan_odometry": filter.params().scan_odometry.enabled.then(|| {
                 let (matched, turned_round, dead) = filter.scan_odometry_counts();
                 json!({ "matched": matched, "turned_round": turned_round, "raw": dead })
@@ -436,6 +477,20 @@ pub fn run(args: SlamArgs) -> Result<ExitCode> {
         super::eval::write_json(path, &summary)?;
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// What an interrupted `slam` says: no output written, where the recording so far is.
+fn interrupted_message(args: &SlamArgs) -> String {
+    let rrd = args
+        .viz
+        .rrd
+        .as_deref()
+        .map(|r| format!("; the recording so far, without its footer: {}", mrslam_viz::partial_path(r).display()));
+    format!(
+        "mrslam slam: interrupted: nothing written to {} (the map, trajectory and summary are written at the end){}",
+        args.output.display(),
+        rrd.unwrap_or_default()
+    )
 }
 
 /// One line on what loop closure did.

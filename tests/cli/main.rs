@@ -11,6 +11,7 @@ mod merge_many;
 mod reliability;
 mod reliability_inputs;
 mod reliability_outputs;
+mod reliability_walk;
 mod run;
 mod run_mcap;
 mod sim;

@@ -92,7 +92,10 @@ fn bad_maps_exit_1_naming_file_and_problem() {
     assert_fails_with(&["map", "info", nores.to_str().unwrap()], &["nores.yaml", "resolution"]);
 
     let negres = write(d, "negres.yaml", b"image: ok.pgm\nresolution: -0.05\norigin: [0, 0, 0]\n");
-    assert_fails_with(&["map", "info", negres.to_str().unwrap()], &["negres.yaml:2", "resolution", "positive"]);
+    assert_fails_with(
+        &["map", "info", negres.to_str().unwrap()],
+        &["negres.yaml:2", "resolution", "between 0.0001 and 100"],
+    );
     let zero = write(d, "zero.yaml", b"image: ok.pgm\nresolution: 0\norigin: [0, 0, 0]\n");
     assert_fails_with(&["map", "info", zero.to_str().unwrap()], &["zero.yaml:2", "resolution"]);
 

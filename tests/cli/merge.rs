@@ -188,10 +188,12 @@ fn correlative_refuses_an_ambiguous_pose_naming_the_rival_unless_the_test_is_off
     let d = dir.path();
     let (a, b, report) = (d.join("a.yaml"), d.join("b.yaml"), d.join("r.json"));
     write_ros_map(&symmetric_building(), &a).unwrap();
-    // The same building seen from another frame (a map merged with itself is refused).
-    let text_a = std::fs::read_to_string(&a).unwrap();
-    let origin = text_a.lines().find(|l| l.starts_with("origin:")).unwrap();
-    std::fs::write(&b, text_a.replace(origin, "origin: [1.5, -2.0, 0.0]")).unwrap();
+    // The same building seen from another frame, by another robot: one corner cell seen free (a map merged with
+    // itself, the same image or the same cells, is refused).
+    let mut other = symmetric_building();
+    other.set_origin(mrslam_core::pose(1.5, -2.0, 0.0));
+    other.set(0, 0, -mrslam_core::map_io::ROS_LOGODDS_LIMIT);
+    write_ros_map(&other, &b).unwrap();
     let run = |extra: &[&str]| {
         let mut args = vec!["merge", p(&a), p(&b), "--algorithm", "correlative", "--report", p(&report)];
         args.extend_from_slice(extra);

@@ -17,7 +17,7 @@ fn names(dir: &Path) -> Vec<String> {
 }
 
 /// A scenario in `dir` on the two-rooms world whose robots stand still: a run of a few simulated seconds.
-fn idle_scenario(dir: &Path, world: &Path, start_a: &str, start_b: &str) -> PathBuf {
+pub fn idle_scenario(dir: &Path, world: &Path, start_a: &str, start_b: &str) -> PathBuf {
     let text = format!(
         "name = \"idle\"\nworld = {:?}\nseed = 1\nduration = 3.0\n\n[merge]\nwhen = 2.0\nalgorithms = [\"sift\"]\n\n\
          [[robots]]\nname = \"a\"\nmodel = \"experia\"\nlidar = \"hokuyo_urg_04lx\"\nstart = \"{start_a}\"\n\
@@ -164,7 +164,7 @@ fn a_map_merged_with_itself_or_its_copy_is_refused() {
     std::fs::copy(d.join("a.pgm"), d.join("copy.pgm")).unwrap();
     std::fs::write(d.join("copy.yaml"), std::fs::read_to_string(&a).unwrap().replace("a.pgm", "copy.pgm")).unwrap();
     fails_with(&["merge", p(&a), p(&a)], &["a.yaml", "the same map file given twice"]);
-    fails_with(&["merge", p(&a), p(&d.join("copy.yaml"))], &["copy.yaml holds the same map as", "a copy?"]);
+    fails_with(&["merge", p(&a), p(&d.join("copy.yaml"))], &["copy.yaml holds the same cells as", "a copy?"]);
     fails_with(&["merge", p(&a), p(&b), p(&a)], &["the same map file given twice"]);
     fails_with(&["merge", p(&a), p(&b), p(&d.join("./b.yaml"))], &["the same map file given twice"]);
 }

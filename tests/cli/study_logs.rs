@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 use std::process::Output;
 
 /// The first 18 m of the synthetic office loop's first corridor, Hokuyo scans, slightly drifting odometry.
-fn run() -> SyntheticRun {
+pub fn run() -> SyntheticRun {
     let path: Vec<Pose2> =
         synthetic::waypoint_path(&synthetic::office_loop(), 0.05, 0.1).into_iter().take(360).collect();
     let drift = Drift { scale: 0.01, heading_per_m: 0.005, sigma_trans: 0.01, sigma_rot: 0.005 };
@@ -18,7 +18,7 @@ fn run() -> SyntheticRun {
 }
 
 /// The run as an old-style CARMEN log: PARAM lines for the laser, one FLASER line per scan.
-fn carmen_log(run: &SyntheticRun) -> String {
+pub fn carmen_log(run: &SyntheticRun) -> String {
     let lidar = Lidar::hokuyo();
     let mut s = format!(
         "PARAM laser_front_laser_fov {}\nPARAM robot_front_laser_max {}\n",
@@ -240,6 +240,13 @@ fn bad_input_is_refused_naming_the_file_and_line() {
     let log = std::fs::read_to_string(&f.log).unwrap();
     std::fs::write(&short, log.lines().take(5).collect::<Vec<_>>().join("\n") + "\n").unwrap();
     refused(&study(&short, &f.rels, "4", &f.root.join("short"), &[]), &["short.clf", "has no scan"]);
+    // A start that failed on its log leaves no study.json to block the corrected retry.
+    assert!(!f.root.join("short/study.json").exists(), "a failed start wrote study.json");
+    let retry = study(&f.log, &f.rels, "2", &f.root.join("short"), &[]);
+    assert_eq!(retry.status.code(), Some(0), "{}", text(&retry.stderr));
+    // A missing chain of folders is not made.
+    refused(&study(&f.log, &f.rels, "2", &f.root.join("missing/deep/x"), &[]), &["--out", "does not exist"]);
+    assert!(!f.root.join("missing").exists());
     // The output folder over an input.
     refused(&study(&f.log, &f.rels, "2", &f.log, &[]), &["is a file"]);
 }

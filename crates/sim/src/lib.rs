@@ -56,4 +56,6 @@ pub use lidar::LidarModel;
 pub use sim::{RayBackend, RobotId, RobotStep, Sim, SimConfig, StepEvents};
 pub use slip::{SlipParams, SlipState};
 pub use world::World;
-pub use world_file::{BitmapLayer, BoxSpec, CircleSpec, NamedPoint, PolygonSpec, WallSpec, WorldSpec};
+pub use world_file::{
+    BitmapLayer, BoxSpec, CircleSpec, MAX_WORLD_COORDINATE, NamedPoint, PolygonSpec, WallSpec, WorldSpec,
+};

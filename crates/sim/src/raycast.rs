@@ -250,4 +250,18 @@ mod tests {
         assert!((t - 0.9).abs() < 1e-12);
         assert!(c.cast(&o, &Vector2::new(-1.0, 0.0), 0.5).is_none());
     }
+
+    #[test]
+    fn obstacles_at_absurd_coordinates_build_a_small_grid_without_overflow() {
+        for far in [1e300, -1e300, 1e308, 1e100] {
+            let obs = vec![
+                Obstacle::Box { center: Point2::new(2.0, 0.0), half: Vector2::new(2.1, 0.1), angle: 0.0 },
+                Obstacle::Box { center: Point2::new(far, 0.0), half: Vector2::new(0.1, 0.1), angle: 0.0 },
+                Obstacle::Circle { center: Point2::new(0.0, far), radius: 1.0 },
+            ];
+            let c = RayCaster::new(&obs, 0.5);
+            assert!(c.nx * c.ny <= 4_000_000, "{far}: {} x {}", c.nx, c.ny);
+            let _ = c.cast(&Point2::new(1.0, 1.0), &Vector2::new(0.0, -1.0), 10.0);
+        }
+    }
 }

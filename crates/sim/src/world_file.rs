@@ -32,6 +32,9 @@ use std::ops::Range;
 use std::path::{Path, PathBuf};
 use toml::Spanned;
 
+/// The largest coordinate or size a world file may hold, metres: the map reader's bound on a map's origin.
+pub const MAX_WORLD_COORDINATE: f64 = mrslam_core::map_io::MAX_COORDINATE;
+
 /// A polyline of wall segments with a thickness.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -328,7 +331,9 @@ impl WorldSpec {
                 },
                 message: msg,
             };
-        let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
+        // Finite and within the bound: a coordinate or a size further out is a typo, and would overflow the grids
+        // the simulator builds over the world.
+        let finite = |v: &[f64]| v.iter().all(|x| x.is_finite() && x.abs() <= MAX_WORLD_COORDINATE);
         for (i, w) in self.walls.iter().enumerate() {
             let s = spans.walls.get(i);
             if w.points.len() < 2 {
@@ -341,7 +346,13 @@ impl WorldSpec {
                 ));
             }
             if !w.points.iter().all(|p| finite(p)) {
-                return Err(err("walls", Some(i), s, "points", "coordinates must be finite".into()));
+                return Err(err(
+                    "walls",
+                    Some(i),
+                    s,
+                    "points",
+                    format!("coordinates must be finite and within {MAX_WORLD_COORDINATE:e} m of 0"),
+                ));
             }
             if let Some(k) = w.points.windows(2).position(|p| p[0] == p[1]) {
                 return Err(err(
@@ -352,14 +363,26 @@ impl WorldSpec {
                     format!("points {k} and {} coincide (zero-length segment)", k + 1),
                 ));
             }
-            if !(w.thickness.is_finite() && w.thickness > 0.0) {
-                return Err(err("walls", Some(i), s, "thickness", format!("must be positive, got {}", w.thickness)));
+            if !(finite(&[w.thickness]) && w.thickness > 0.0) {
+                return Err(err(
+                    "walls",
+                    Some(i),
+                    s,
+                    "thickness",
+                    format!("must be positive and at most {MAX_WORLD_COORDINATE:e} m, got {}", shown(w.thickness)),
+                ));
             }
         }
         for (i, b) in self.boxes.iter().enumerate() {
             let s = spans.boxes.get(i);
             if !finite(&b.center) {
-                return Err(err("boxes", Some(i), s, "center", "must be finite".into()));
+                return Err(err(
+                    "boxes",
+                    Some(i),
+                    s,
+                    "center",
+                    format!("must be within {MAX_WORLD_COORDINATE:e} m of 0"),
+                ));
             }
             if !(finite(&b.size) && b.size[0] > 0.0 && b.size[1] > 0.0) {
                 return Err(err(
@@ -367,7 +390,11 @@ impl WorldSpec {
                     Some(i),
                     s,
                     "size",
-                    format!("both sides must be positive, got [{}, {}]", b.size[0], b.size[1]),
+                    format!(
+                        "both sides must be positive and at most {MAX_WORLD_COORDINATE:e} m, got [{}, {}]",
+                        shown(b.size[0]),
+                        shown(b.size[1])
+                    ),
                 ));
             }
             if !b.angle.is_finite() {
@@ -377,10 +404,22 @@ impl WorldSpec {
         for (i, c) in self.circles.iter().enumerate() {
             let s = spans.circles.get(i);
             if !finite(&c.center) {
-                return Err(err("circles", Some(i), s, "center", "must be finite".into()));
+                return Err(err(
+                    "circles",
+                    Some(i),
+                    s,
+                    "center",
+                    format!("must be within {MAX_WORLD_COORDINATE:e} m of 0"),
+                ));
             }
-            if !(c.radius.is_finite() && c.radius > 0.0) {
-                return Err(err("circles", Some(i), s, "radius", format!("must be positive, got {}", c.radius)));
+            if !(finite(&[c.radius]) && c.radius > 0.0) {
+                return Err(err(
+                    "circles",
+                    Some(i),
+                    s,
+                    "radius",
+                    format!("must be positive and at most {MAX_WORLD_COORDINATE:e} m, got {}", shown(c.radius)),
+                ));
             }
         }
         for (i, p) in self.polygons.iter().enumerate() {
@@ -395,7 +434,13 @@ impl WorldSpec {
                 ));
             }
             if !p.points.iter().all(|q| finite(q)) {
-                return Err(err("polygons", Some(i), s, "points", "coordinates must be finite".into()));
+                return Err(err(
+                    "polygons",
+                    Some(i),
+                    s,
+                    "points",
+                    format!("coordinates must be finite and within {MAX_WORLD_COORDINATE:e} m of 0"),
+                ));
             }
             let pts = to_points(&p.points);
             if signed_area(&pts).abs() < 1e-9 {
@@ -408,11 +453,17 @@ impl WorldSpec {
         for (name, p) in &self.named_points {
             let s = spans.named_points.get(name);
             if !finite(&[p.x, p.y, p.theta]) {
-                return Err(err("named_points", None, s, name, "x, y and theta must be finite".into()));
+                let message = format!("x, y and theta must be finite and within {MAX_WORLD_COORDINATE:e} m of 0");
+                return Err(err("named_points", None, s, name, message));
             }
         }
         Ok(())
     }
+}
+
+/// A number as an error shows it: as written when ordinary, in scientific notation when huge (not 300 digits).
+fn shown(v: f64) -> String {
+    if v.abs() < 1e7 { v.to_string() } else { format!("{v:e}") }
 }
 
 fn strip_vec<T>(v: Vec<Spanned<T>>, spans: &mut Vec<Range<usize>>) -> Vec<T> {
@@ -517,6 +568,30 @@ end = { x = 3, y = 1 }
             "polygons[0].points",
         );
         assert!(m.contains("cross"));
+    }
+
+    #[test]
+    fn coordinates_and_sizes_past_the_bound_are_rejected() {
+        for far in ["1e300", "1e100", "-2e7"] {
+            let m = expect_err(
+                &GOOD.replace("[[0, 0], [4, 0], [4, 3]]", &format!("[[0, 0], [{far}, 0]]")),
+                4,
+                "walls[0].points",
+            );
+            assert!(m.contains("within 1e7 m of 0"), "{m}");
+            expect_err(&GOOD.replace("center = [3, 2]", &format!("center = [3, {far}]")), 10, "circles[0].center");
+            expect_err(&GOOD.replace("center = [1, 1]", &format!("center = [{far}, 1]")), 7, "boxes[0].center");
+            expect_err(
+                &GOOD.replace("end = { x = 3, y = 1 }", &format!("end = {{ x = {far}, y = 1 }}")),
+                16,
+                "named_points.end",
+            );
+        }
+        let m = expect_err(&GOOD.replace("radius = 0.1", "radius = 1e300"), 11, "circles[0].radius");
+        assert!(m.ends_with("got 1e300"), "{m}");
+        expect_err(&GOOD.replace("thickness = 0.2", "thickness = 1e300"), 5, "walls[0].thickness");
+        expect_err(&GOOD.replace("size = [0.5, 0.4]", "size = [1e300, 0.4]"), 8, "boxes[0].size");
+        assert!(parse(&GOOD.replace("[[0, 0], [4, 0], [4, 3]]", "[[0, 0], [1e7, 0]]")).is_ok());
     }
 
     #[test]

@@ -62,7 +62,8 @@ impl StudyParams {
 
     /// Fails, naming the first parameter that differs, unless `other` (read from `path`) is the same study.
     pub fn check_same(&self, other: &StudyParams, path: &Path, what: &str) -> Result<(), StudyError> {
-        let keys: BTreeSet<&String> = self.0.keys().chain(other.0.keys()).collect();
+        let keys: BTreeSet<&String> =
+            self.0.keys().chain(other.0.keys()).filter(|k| k.as_str() != SHARD_TRIALS_PARAM).collect();
         for k in keys {
             let (mine, theirs) = (self.0.get(k), other.0.get(k));
             if mine != theirs {
@@ -86,6 +87,31 @@ impl StudyParams {
 /// the one parameter in which the shards of one study differ.
 pub const SHARD_PARAM: &str = "shard";
 
+/// The parameter holding how many trials a shard runs (set with [`SHARD_PARAM`]): what `collect` checks the
+/// shard's `results.csv` against. Not part of what the study is: [`StudyParams::check_same`] passes over it, so
+/// the shards of one study, and a shard started before it existed, still compare equal.
+pub const SHARD_TRIALS_PARAM: &str = "shard_trials";
+
+/// The shards among `dirs` whose `results.csv` holds fewer trials than their `study.json` says they run (an
+/// interrupted shard), one line each: `DIR: M of N trials`. Folders without the count are not judged.
+pub fn incomplete_shards(dirs: &[PathBuf]) -> Result<Vec<String>, StudyError> {
+    let mut incomplete = Vec::new();
+    for d in dirs {
+        let Some(params) = StudyParams::read(d)? else { continue };
+        let Some(want) = params.0.get(SHARD_TRIALS_PARAM).and_then(|v| v.parse::<usize>().ok()) else { continue };
+        let path = d.join(RESULTS_FILE);
+        let text = mrslam_core::input::read_text_limited(&path, mrslam_core::input::DATA_LIMIT)
+            .map_err(|e| StudyError::file(&path, e))?;
+        // The trial is every results file's first column.
+        let trials: BTreeSet<&str> =
+            text.lines().skip(1).filter(|l| !l.trim().is_empty()).filter_map(|l| l.split(',').next()).collect();
+        if trials.len() < want {
+            incomplete.push(format!("{}: {} of {want} trials", d.display(), trials.len()));
+        }
+    }
+    Ok(incomplete)
+}
+
 /// The shards of `count` that `found` (their 0-based indices) lacks.
 fn missing_shards(found: &BTreeSet<usize>, count: usize) -> Vec<usize> {
     (0..count).filter(|k| !found.contains(k)).collect()
@@ -100,6 +126,9 @@ pub fn collect_params(dirs: &[PathBuf], partial: bool) -> Result<(Option<StudyPa
     let mut shards: BTreeMap<usize, BTreeSet<usize>> = BTreeMap::new();
     for d in dirs {
         let mut p = StudyParams::read(d)?;
+        if let Some(p) = p.as_mut() {
+            p.0.remove(SHARD_TRIALS_PARAM);
+        }
         if let Some(shard) = p.as_mut().and_then(|p| p.0.remove(SHARD_PARAM)) {
             let s = crate::Shard::parse(&shard).map_err(|e| StudyError::File {
                 path: d.join(PARAMS_FILE),
@@ -155,6 +184,10 @@ pub struct Journal<R> {
     path: PathBuf,
     file: Mutex<std::fs::File>,
     rows: PhantomData<fn(&R)>,
+    /// Opened fresh (not resumed): its `study.json` and `results.csv` were made by this run.
+    fresh: bool,
+    /// Whether any rows were appended.
+    appended: std::sync::atomic::AtomicBool,
 }
 
 impl<R: CsvRow> Journal<R> {
@@ -198,7 +231,21 @@ impl<R: CsvRow> Journal<R> {
         let text = rows_text(&done);
         mrslam_core::output::write_file_atomic(&path, text.as_bytes()).map_err(|e| StudyError::file(&path, e))?;
         let file = std::fs::OpenOptions::new().append(true).open(&path).map_err(|e| StudyError::file(&path, e))?;
-        Ok((Journal { path, file: Mutex::new(file), rows: PhantomData }, done))
+        let appended = std::sync::atomic::AtomicBool::new(false);
+        Ok((Journal { path, file: Mutex::new(file), rows: PhantomData, fresh: !resume, appended }, done))
+    }
+
+    /// Undoes a fresh start that produced nothing (it failed before its first trial finished): removes the
+    /// `results.csv` and `study.json` it wrote, so that the corrected retry starts as if it were the first.
+    /// A resumed study, or one with rows, is left as it is.
+    pub fn abandon(self) {
+        if self.fresh && !self.appended.load(std::sync::atomic::Ordering::SeqCst) {
+            drop(self.file);
+            let _ = std::fs::remove_file(&self.path);
+            if let Some(dir) = self.path.parent() {
+                let _ = std::fs::remove_file(dir.join(PARAMS_FILE));
+            }
+        }
     }
 
     /// Appends the rows of one or more finished trials in one write and flushes them to the file.
@@ -209,6 +256,7 @@ impl<R: CsvRow> Journal<R> {
             text.push('\n');
         }
         let mut file = self.file.lock().map_err(|_| StudyError::file(&self.path, "a writer panicked"))?;
+        self.appended.store(true, std::sync::atomic::Ordering::SeqCst);
         file.write_all(text.as_bytes()).and_then(|()| file.flush()).map_err(|e| StudyError::file(&self.path, e))
     }
 }
@@ -259,6 +307,28 @@ mod tests {
         assert!(e.contains("split 2 and 3 ways"), "{e}");
     }
 
+    #[test]
+    fn a_shard_with_fewer_trials_than_it_runs_is_incomplete_and_its_count_is_not_what_the_study_is() {
+        let dir = tempfile::tempdir().unwrap();
+        let d = dir.path().join("s0");
+        std::fs::create_dir_all(&d).unwrap();
+        let mut p = StudyParams::default();
+        p.set("kind", "overlap").set(SHARD_PARAM, "0/2").set(SHARD_TRIALS_PARAM, 3);
+        p.write(&d).unwrap();
+        let header = crate::results::HEADER;
+        std::fs::write(d.join(RESULTS_FILE), format!("{header}\n0,a\n0,b\n2,a\n")).unwrap();
+        assert_eq!(
+            incomplete_shards(std::slice::from_ref(&d)).unwrap(),
+            vec![format!("{}: 2 of 3 trials", d.display())]
+        );
+        std::fs::write(d.join(RESULTS_FILE), format!("{header}\n0,a\n2,a\n4,a\n")).unwrap();
+        assert!(incomplete_shards(std::slice::from_ref(&d)).unwrap().is_empty());
+        // A shard folder from before the count resumes as the same study.
+        let mut old = p.clone();
+        old.0.remove(SHARD_TRIALS_PARAM);
+        assert!(p.check_same(&old, &d, "cannot resume").is_ok());
+    }
+
     fn row(trial: usize, alg: &str) -> TrialRow {
         TrialRow {
             trial,
@@ -276,6 +346,26 @@ mod tests {
             translation_error_at_end_m: None,
             stage: String::new(),
         }
+    }
+
+    #[test]
+    fn a_fresh_start_that_produced_nothing_is_undone_and_no_other() {
+        let dir = tempfile::tempdir().unwrap();
+        let d = dir.path();
+        let mut params = StudyParams::default();
+        params.set("seed", 5);
+        let (j, _) = Journal::<TrialRow>::open(d, &params, 1, false).unwrap();
+        j.abandon();
+        assert!(!d.join(RESULTS_FILE).exists() && !d.join(PARAMS_FILE).exists());
+        // Rows written: kept.
+        let (j, _) = Journal::<TrialRow>::open(d, &params, 1, false).unwrap();
+        j.append(&[row(0, "sift")]).unwrap();
+        j.abandon();
+        assert!(d.join(RESULTS_FILE).exists() && d.join(PARAMS_FILE).exists());
+        // A resumed study: kept, although this run added nothing.
+        let (j, _) = Journal::<TrialRow>::open(d, &params, 1, true).unwrap();
+        j.abandon();
+        assert!(d.join(RESULTS_FILE).exists() && d.join(PARAMS_FILE).exists());
     }
 
     #[test]

@@ -43,10 +43,12 @@ pub fn parse_whole_numbers(s: &str, flag: &str) -> Result<Vec<u64>, StudyError> 
             if stop < start {
                 return Err(bad(format!("empty: stop {stop} is below start {start}")));
             }
-            let n = (stop - start) / step + 1;
-            if n > MAX_VALUES as u64 {
-                return Err(bad(format!("{n} values; at most {MAX_VALUES}")));
+            // Counted before adding the first value, so that 0:18446744073709551615 cannot overflow.
+            let gaps = (stop - start) / step;
+            if gaps >= MAX_VALUES as u64 {
+                return Err(bad(format!("{} values; at most {MAX_VALUES}", u128::from(gaps) + 1)));
             }
+            let n = gaps + 1;
             (0..n).map(|i| start + i * step).collect()
         }
         None => s.split(',').map(num).collect::<Result<Vec<_>, _>>()?,
@@ -113,6 +115,8 @@ mod tests {
         assert_eq!(e("0:4:0"), "--seeds `0:4:0`: step must be at least 1");
         assert_eq!(e("1:2:3:4"), "--seeds `1:2:3:4`: expected start:stop or start:stop:step");
         assert!(e("0:99999").contains("at most 10000"));
+        assert!(e("0:18446744073709551615").contains("18446744073709551616 values; at most 10000"));
+        assert!(e("5:18446744073709551615:2").contains("at most 10000"));
         assert!(e("").contains("is not a whole number"));
     }
 

@@ -88,19 +88,38 @@ impl MapStyle {
     }
 }
 
+/// The most trials per overlap a study takes (a million trials of a study take days).
+pub const MAX_TRIALS: usize = 100_000;
+
+/// The most trials a study takes in all, overlaps times trials.
+pub const MAX_STUDY_TRIALS: usize = 1_000_000;
+
+/// The most generated floor plans a study takes.
+pub const MAX_FLOORPLANS: usize = 10_000;
+
 impl OverlapStudy {
     /// Checks the parameters.
     pub fn validate(&self) -> Result<(), StudyError> {
         let bad = |m: String| Err(StudyError::Invalid(m));
-        if self.trials == 0 {
-            return bad("--trials must be at least 1".into());
+        if !(1..=MAX_TRIALS).contains(&self.trials) {
+            return bad(format!("--trials {}: must be from 1 to {MAX_TRIALS}", self.trials));
         }
         if self.overlaps.is_empty() {
             return bad("no overlaps to study".into());
         }
+        let total = self.overlaps.len().saturating_mul(self.trials);
+        if total > MAX_STUDY_TRIALS {
+            return bad(format!(
+                "{} overlaps x {} trials = {total} trials; a study runs at most {MAX_STUDY_TRIALS} (shards included)",
+                self.overlaps.len(),
+                self.trials
+            ));
+        }
         check_algorithms(&self.algorithms)?;
-        if let MapSource::Floorplans { count: 0, .. } = self.source {
-            return bad("--floorplans must be at least 1".into());
+        if let MapSource::Floorplans { count, .. } = self.source
+            && !(1..=MAX_FLOORPLANS).contains(&count)
+        {
+            return bad(format!("--floorplans {count}: must be from 1 to {MAX_FLOORPLANS}"));
         }
         if !(self.max_rotation_deg >= 0.0 && self.max_translation_cells >= 0.0 && self.max_shift_m >= 0.0) {
             return bad("success thresholds and the shift must not be negative".into());

@@ -138,6 +138,19 @@ impl Sweep {
             if v.values.is_empty() {
                 return Err(at(line_of(&f("values")), format!("{}: give at least one value", f("values"))));
             }
+            let bound = mrslam_sim::MAX_WORLD_COORDINATE;
+            if let Some(k) = v.values.iter().position(|x| !(x.is_finite() && x.abs() <= bound)) {
+                let field = format!("{}[{k}]", f("values"));
+                let message = format!(
+                    "{field} = {:e}: must be a finite number within {bound:e} of 0 (metres or m/s)",
+                    v.values[k]
+                );
+                return Err(at(line_of(&field), message));
+            }
+            if field != Field::Speed && scenario.robots[robot].route.is_empty() {
+                let message = format!("{}: robot `{}` has no route whose end could move", f("field"), v.robot);
+                return Err(at(line_of(&f("field")), message));
+            }
             if let Some(first) = file.vary.first()
                 && first.values.len() != v.values.len()
             {
@@ -301,5 +314,10 @@ mod tests {
         assert!(e.contains("sweep.toml:11: vary[1].values[1] = 9: speed 9 outside"), "{e}");
         let e = sweep_error(&format!("{head}{}{}", vary("experia", "[0.3]"), vary("robbie", "[0.3]")));
         assert!(e.contains("sweep.toml:9: vary[1].robot: no robot `robbie`"), "{e}");
+        // A value far past any world is refused, in a line of ordinary length.
+        let far = "[[vary]]\nrobot = \"experia\"\nfield = \"route_end_x\"\nvalues = [1e300]\n";
+        let e = sweep_error(&format!("{head}{far}"));
+        assert!(e.contains("sweep.toml:7: vary[0].values[0] = 1e300: must be a finite number within 1e7"), "{e}");
+        assert!(e.len() < 300, "{e}");
     }
 }

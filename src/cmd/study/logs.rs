@@ -32,8 +32,8 @@ pub struct LogsArgs {
     /// Number of parts ("robots"): consecutive stretches of the log of equal duration, at least 2.
     #[arg(long)]
     pub parts: usize,
-    /// Output folder: study.json, results.csv, summary.csv, plot.png, parts.csv, part-K.yaml/.pgm and
-    /// part-K.trajectory.txt (each part's map and its pose at every scan).
+    /// Output folder: study.json, results.csv, summary.csv, plot.png, parts.csv, part-K.yaml with its .pgm and
+    /// its PNG preview part-K.png, and part-K.trajectory.txt (each part's map and its pose at every scan).
     #[arg(long)]
     pub out: PathBuf,
     /// How to read the log.
@@ -120,6 +120,7 @@ pub(super) fn run(a: LogsArgs) -> Result<ExitCode> {
     let mut slam = a.preset.params();
     set_each("--slam-set", &a.slam_set, |name, value| slam.set(name, value))?;
     slam.validate().map_err(|e| anyhow::anyhow!("slam parameters: {e}"))?;
+    crate::cmd::slam::check_map_resolution("--slam-set", &slam)?;
     // Outputs: never over an input; checked before any work.
     if a.out.is_file() {
         bail!("--out {}: is a file, expected a folder", a.out.display());
@@ -183,22 +184,34 @@ pub(super) fn run(a: LogsArgs) -> Result<ExitCode> {
                 );
             }
         }
-        params.write(&a.out)?;
     }
 
     let mut log = a.read.read(&a.log)?;
     if log.scans.is_empty() {
         bail!("{}: no laser scans in the log", a.log.display());
     }
-    if !a.drift.is_none() {
+    // The drift asked for; then the scan lines' odometry of a log without a stream re-timed by its lag, as
+    // `mrslam slam` does.
+    let retimed = log.odometry.is_empty() && slam.scan_odometry.enabled && slam.scan_odometry.line_lag;
+    if retimed || !a.drift.is_none() {
         let mut odometry: Vec<_> = log.scans.iter().map(|r| r.odometry).collect();
         a.drift.inject(&mut odometry, a.seed);
+        if retimed {
+            let scans: Vec<&mrslam_core::LaserScan> = log.scans.iter().map(|r| &r.scan).collect();
+            let offset = log.scans[0].laser_offset;
+            mrslam_slam::odometry_lag::retime_line_odometry(&mut odometry, &scans, &slam, offset);
+        }
         for (r, o) in log.scans.iter_mut().zip(odometry) {
             r.odometry = o;
         }
     }
     let stamps: Vec<f64> = log.scans.iter().map(|r| r.scan.stamp).collect();
     let ranges = logs::split_by_time(&stamps, a.parts).with_context(|| format!("{}", a.log.display()))?;
+    // The study starts producing here: study.json is written only now, so that a start that fails on its log
+    // leaves nothing that blocks the corrected retry.
+    if !a.resume {
+        params.write(&a.out)?;
+    }
     let start = Instant::now();
     let mut parts = Vec::with_capacity(a.parts);
     let mut parts_csv = String::from("part,first_stamp,last_stamp,scans,processed,slam_s,width,height,known_cells\n");
@@ -318,7 +331,8 @@ pub(super) fn run(a: LogsArgs) -> Result<ExitCode> {
         start.elapsed().as_secs_f64()
     );
     println!(
-        "outputs:  {} (study.json, results.csv, summary.csv, plot.png, parts.csv, part-K.yaml, part-K.trajectory.txt)",
+        "outputs:  {} (study.json, results.csv, summary.csv, plot.png, parts.csv, part-K.yaml + .pgm + .png, \
+         part-K.trajectory.txt)",
         a.out.display()
     );
     Ok(ExitCode::SUCCESS)

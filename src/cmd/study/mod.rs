@@ -55,7 +55,7 @@ pub fn run(cmd: StudyCommand) -> Result<ExitCode> {
 #[derive(clap::Args)]
 pub struct StudyRun {
     /// Run only shard K of N (trial index mod N = K); default from SLURM_ARRAY_TASK_ID/SLURM_ARRAY_TASK_COUNT.
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     pub shard: Option<String>,
     /// No progress bar.
     #[arg(long)]
@@ -72,10 +72,12 @@ pub(super) fn shard_of(arg: Option<&str>) -> Result<Shard> {
     })
 }
 
-/// Names the shard in a sharded study's parameters, so that `collect` can tell when one is missing.
-pub(super) fn name_shard(params: &mut StudyParams, shard: Shard) {
+/// Names the shard in a sharded study's parameters, and how many trials it runs, so that `collect` can tell
+/// when one is missing or incomplete.
+pub(super) fn name_shard(params: &mut StudyParams, shard: Shard, trials: usize) {
     if shard.count > 1 {
         params.set(mrslam_studies::journal::SHARD_PARAM, format!("{}/{}", shard.index, shard.count));
+        params.set(mrslam_studies::journal::SHARD_TRIALS_PARAM, trials);
     }
 }
 
@@ -109,8 +111,10 @@ fn rate_text(per_sec: f64) -> String {
     format!("{rate:.decimals$}/{unit}")
 }
 
+/// Makes the study folder `dir` when it is not there; as every command's outputs, its parent must exist (a typo
+/// in `--out` makes no chain of folders).
 pub(super) fn create_out(dir: &Path) -> Result<()> {
-    std::fs::create_dir_all(dir).with_context(|| format!("{}: cannot create output folder", dir.display()))
+    crate::cmd::paths::create_out_folder(dir)
 }
 
 /// A running study's progress: the trials done before a resume are skipped; each finished trial's rows are
@@ -191,7 +195,15 @@ pub(super) fn run_study<R: CsvRow>(
     let n = selected.iter().filter(|t| !done.contains(t)).count();
     let recorder = Recorder { journal, done, bar: progress_bar(n, quiet, what) };
     let start = Instant::now();
-    let new = run(&recorder)?;
+    let new = match run(&recorder) {
+        Ok(new) => new,
+        Err(e) => {
+            recorder.bar.finish_and_clear();
+            // A fresh start that failed before its first trial leaves nothing to block the corrected retry.
+            recorder.journal.abandon();
+            return Err(e.into());
+        }
+    };
     let seconds = start.elapsed().as_secs_f64();
     recorder.bar.finish_and_clear();
     let mut rows = earlier;

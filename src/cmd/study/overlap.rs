@@ -28,13 +28,13 @@ pub struct OverlapArgs {
     #[arg(long)]
     pub floorplans: Option<usize>,
     /// Size of the generated floor plans, metres, WIDTHxHEIGHT.
-    #[arg(long, default_value = "24x18")]
+    #[arg(long, default_value = "24x18", allow_hyphen_values = true)]
     pub floorplan_size: String,
     /// Cell size of a world's true map or of generated floor plans, metres.
     #[arg(long, default_value_t = 0.05)]
     pub resolution: f64,
     /// Target overlaps: start:stop:step (stop included), a list a,b,c, or one value.
-    #[arg(long, default_value = "0.05:0.7:0.05")]
+    #[arg(long, default_value = "0.05:0.7:0.05", allow_hyphen_values = true)]
     pub overlaps: String,
     /// Trials per overlap.
     #[arg(long, default_value_t = 30)]
@@ -80,15 +80,12 @@ fn floorplan_size(s: &str) -> Result<(f64, f64)> {
 pub(super) fn run(a: OverlapArgs) -> Result<ExitCode> {
     let shard = shard_of(a.run.shard.as_deref())?;
     let overlaps = parse_range(&a.overlaps).context("--overlaps")?;
-    if a.trials == 0 {
-        bail!("--trials must be at least 1");
-    }
-    if !(a.resolution > 0.0 && a.resolution.is_finite()) {
-        bail!("--resolution must be positive, got {}", a.resolution);
+    let (lo, hi) = (mrslam_core::map_io::MIN_RESOLUTION, mrslam_core::map_io::MAX_RESOLUTION);
+    if !(lo..=hi).contains(&a.resolution) {
+        bail!("--resolution {:e}: must be between {lo} and {hi} metres per cell", a.resolution);
     }
     let mut params = StudyParams::default();
     params.set("kind", "overlap");
-    super::name_shard(&mut params, shard);
     let source = if let Some(path) = &a.map {
         let grid = crate::cmd::map::read_yaml_map(path).with_context(|| format!("--map {}", path.display()))?;
         params.set("map", fingerprint(&grid_bytes(&grid)));
@@ -118,6 +115,8 @@ pub(super) fn run(a: OverlapArgs) -> Result<ExitCode> {
         encoding: a.encoding,
     };
     study.validate()?;
+    let selected: Vec<usize> = study.selected_trials().iter().map(|t| t.trial).collect();
+    super::name_shard(&mut params, shard, selected.len());
     let overlaps: Vec<String> = study.overlaps.iter().map(|o| o.to_string()).collect();
     let algorithms: Vec<String> = study.algorithms.iter().map(|x| x.name().to_string()).collect();
     params
@@ -133,7 +132,6 @@ pub(super) fn run(a: OverlapArgs) -> Result<ExitCode> {
         .set("encoding", a.encoding);
     let inputs = a.map.iter().chain(&a.world).map(PathBuf::as_path);
     let (journal, earlier) = open_study(&a.out, inputs, &[], &params, algorithms.len(), a.run.resume)?;
-    let selected: Vec<usize> = study.selected_trials().iter().map(|t| t.trial).collect();
     let (mut rows, n, seconds) =
         run_study(earlier, journal, &selected, a.run.quiet, "overlap study", |p| run_overlap_study(&study, p))?;
     sort_rows(&mut rows, &algorithms);

@@ -49,7 +49,7 @@ pub(super) fn run(a: ScenarioArgs) -> Result<ExitCode> {
     }
     let mut params = StudyParams::default();
     params.set("kind", "scenario");
-    super::name_shard(&mut params, shard);
+    super::name_shard(&mut params, shard, (0..sweep.trials()).filter(|t| shard.selects(*t)).count());
     for (name, path) in
         [("sweep", &sweep.path), ("scenario", &sweep.scenario.path), ("world", &sweep.scenario.world_path)]
     {

@@ -25,20 +25,20 @@ pub struct TeamArgs {
     pub run: super::StudyRun,
     /// Numbers of robots: a trial takes the first N of the scenario's `[[robots]]`. A list a,b,c or start:stop
     /// (both included); default: all of them.
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     pub robots: Option<String>,
     /// Communication ranges, metres: a list a,b,c or start:stop:step; default: the scenario's team.range.
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     pub range: Option<String>,
     /// Coordinations, comma-separated: none, frontiers; default: the scenario's team.coordination.
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     pub coordination: Option<String>,
     /// Online mergers, comma-separated (sift, rmap, correlative, cascade); default: the scenario's team.merger.
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     pub merger: Option<String>,
     /// Seeds (each replaces the scenario's): a list a,b,c, start:stop (both included) or start:stop:step. Every
     /// configuration runs once per seed.
-    #[arg(long, default_value = "0:9")]
+    #[arg(long, default_value = "0:9", allow_hyphen_values = true)]
     pub seeds: String,
     /// Simulated seconds a run lasts at most, instead of the scenario's duration.
     #[arg(long)]
@@ -116,7 +116,7 @@ pub(super) fn run(a: TeamArgs) -> Result<ExitCode> {
     }
     let mut params = StudyParams::default();
     params.set("kind", "team");
-    super::name_shard(&mut params, shard);
+    super::name_shard(&mut params, shard, selected.len());
     params
         .set("scenario", file_id(&study.scenario.path)?)
         .set("world", file_id(&study.scenario.world_path)?)

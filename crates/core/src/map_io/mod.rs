@@ -29,4 +29,7 @@ pub use preview::{
     OverlayLayer, overlay, preview_image, preview_path, preview_with_path, write_map_preview, write_rgb_png,
 };
 pub use ros_map::{read_ros_map, read_ros_map_with, resolve_image_path, write_ros_map, write_ros_map_with_preview};
-pub use yaml::{MAP_YAML_KEYS, MapMode, MapYaml, map_yaml_text, parse_map_yaml, parse_map_yaml_with};
+pub use yaml::{
+    MAP_YAML_KEYS, MAX_COORDINATE, MAX_RESOLUTION, MIN_RESOLUTION, MapMode, MapYaml, map_yaml_text, parse_map_yaml,
+    parse_map_yaml_with,
+};

@@ -40,6 +40,10 @@ pub struct MapYaml {
 /// The coarsest map resolution read, metres per pixel: a pixel larger than a building is a typo.
 pub const MAX_RESOLUTION: f64 = 100.0;
 
+/// The finest map resolution read, metres per pixel (0.1 mm): a finer pixel is a typo, and a map at it would
+/// need billions of cells to be merged with a map of any robot's resolution.
+pub const MIN_RESOLUTION: f64 = 1e-4;
+
 /// The largest origin coordinate read, metres (ten thousand kilometres).
 pub const MAX_COORDINATE: f64 = 1e7;
 
@@ -138,10 +142,13 @@ pub fn parse_map_yaml_with(text: &str, path: &Path, warn: &mut dyn FnMut(String)
             }
             "resolution" => {
                 let r = number("resolution")?;
-                if !(r > 0.0 && r <= MAX_RESOLUTION) {
+                if !(MIN_RESOLUTION..=MAX_RESOLUTION).contains(&r) {
                     return Err(bad(
                         "resolution",
-                        format!("must be positive and at most {MAX_RESOLUTION} metres per pixel, found {}", shown()),
+                        format!(
+                            "must be between {MIN_RESOLUTION} and {MAX_RESOLUTION} metres per pixel, found {}",
+                            shown()
+                        ),
                     ));
                 }
                 resolution = Some(r);
@@ -241,7 +248,12 @@ mod tests {
     #[test]
     fn absurd_scales_are_refused() {
         let e = yaml("image: m.pgm\nresolution: 1e300\norigin: [0, 0, 0]\n").unwrap_err().to_string();
-        assert!(e.contains("m.yaml:2") && e.contains("at most 100 metres per pixel, found 1e300"), "{e}");
+        assert!(e.contains("m.yaml:2") && e.contains("and 100 metres per pixel, found 1e300"), "{e}");
+        for tiny in ["1e-5", "1e-20", "0"] {
+            let e = yaml(&format!("image: m.pgm\nresolution: {tiny}\norigin: [0, 0, 0]\n")).unwrap_err().to_string();
+            assert!(e.contains("m.yaml:2") && e.contains("between 0.0001 and 100 metres per pixel"), "{e}");
+        }
+        assert!(yaml("image: m.pgm\nresolution: 1e-4\norigin: [0, 0, 0]\n").is_ok());
         let e = yaml("image: m.pgm\nresolution: 0.05\norigin: [1e300, 0, 0]\n").unwrap_err().to_string();
         assert!(e.contains("m.yaml:3") && e.contains("further than 1e7 m"), "{e}");
         assert!(yaml("image: m.pgm\nresolution: 100\norigin: [-1e7, 0, 0]\n").is_ok());
@@ -252,7 +264,7 @@ mod tests {
         let e = yaml("image: m.pgm\norigin: [0, 0, 0]\n").unwrap_err().to_string();
         assert!(e.contains("m.yaml") && e.contains("missing required field `resolution`"), "{e}");
         let e = yaml("image: m.pgm\nresolution: -0.05\norigin: [0, 0, 0]\n").unwrap_err().to_string();
-        assert!(e.contains("m.yaml:2") && e.contains("`resolution`") && e.contains("positive"), "{e}");
+        assert!(e.contains("m.yaml:2") && e.contains("`resolution`") && e.contains("between 0.0001 and 100"), "{e}");
         let e = yaml("image: m.pgm\nresolution: 0\norigin: [0, 0, 0]\n").unwrap_err().to_string();
         assert!(e.contains("m.yaml:2"), "{e}");
         let e = yaml("image: m.pgm\nresolution: 0.05\norigin: [0, 0]\n").unwrap_err().to_string();

@@ -8,6 +8,9 @@ use crate::StudyError;
 use mrslam_merge::Algorithm;
 use mrslam_testbed::scenario::{Coordination, Scenario};
 
+/// The longest communication range a study takes, metres: further is a typo (1e6 m reaches across any world).
+pub const MAX_RANGE: f64 = 1e6;
+
 /// One configuration of a team study: what its trials share besides the scenario.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Config {
@@ -103,8 +106,8 @@ impl TeamStudy {
         }
         let ranges = axes.ranges.unwrap_or_else(|| vec![team.range]);
         distinct(&ranges, "--range")?;
-        if let Some(r) = ranges.iter().find(|r| !(r.is_finite() && **r >= 0.0)) {
-            return bad(format!("--range {r}: a range must be a finite number of metres, at least 0"));
+        if let Some(r) = ranges.iter().find(|r| !(r.is_finite() && **r >= 0.0 && **r <= MAX_RANGE)) {
+            return bad(format!("--range {r:e}: a range must be a number of metres from 0 to {MAX_RANGE:e}"));
         }
         let coordinations = axes.coordinations.unwrap_or_else(|| vec![team.coordination]);
         distinct(&coordinations, "--coordination")?;
@@ -112,8 +115,9 @@ impl TeamStudy {
         distinct(&mergers, "--merger")?;
         distinct(&axes.seeds, "--seeds")?;
         if let Some(d) = axes.duration {
-            if !(d.is_finite() && d > 0.0) {
-                return bad(format!("--duration {d}: must be a positive number of seconds"));
+            let most = mrslam_testbed::scenario::MAX_DURATION;
+            if !(d > 0.0 && d <= most) {
+                return bad(format!("--duration {d:e}: must be a positive number of seconds, at most {most:e}"));
             }
             scenario.duration = d;
         }
@@ -250,7 +254,11 @@ mod tests {
         let bad_range = TeamAxes { ranges: Some(vec![f64::NAN]), ..axes(&[1], &[Coordination::None], &[1]) };
         assert!(e(bad_range).starts_with("--range NaN:"));
         let bad_duration = TeamAxes { duration: Some(0.0), ..axes(&[1], &[Coordination::None], &[1]) };
-        assert_eq!(e(bad_duration), "--duration 0: must be a positive number of seconds");
+        assert_eq!(e(bad_duration), "--duration 0e0: must be a positive number of seconds, at most 1e6");
+        let far_range = TeamAxes { ranges: Some(vec![1e300]), ..axes(&[1], &[Coordination::None], &[1]) };
+        assert_eq!(e(far_range), "--range 1e300: a range must be a number of metres from 0 to 1e6");
+        let long = TeamAxes { duration: Some(1e300), ..axes(&[1], &[Coordination::None], &[1]) };
+        assert_eq!(e(long), "--duration 1e300: must be a positive number of seconds, at most 1e6");
         let mut no_team = two_rooms();
         no_team.team = None;
         let msg = TeamStudy::new(no_team, axes(&[1], &[Coordination::None], &[1])).unwrap_err().to_string();

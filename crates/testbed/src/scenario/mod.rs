@@ -21,6 +21,12 @@ use mrslam_core::toml_lines::{TomlLines, line_at};
 use mrslam_sim::{World, WorldSpec};
 use std::path::{Path, PathBuf};
 
+/// The longest simulated time a scenario may ask for, seconds (11.6 days).
+pub const MAX_DURATION: f64 = 1e6;
+
+/// The shortest physics step, seconds: a shorter one only makes a run take forever.
+pub const MIN_DT: f64 = 1e-4;
+
 /// A merge counts as a success when accepted and within these errors of the truth.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct Success {
@@ -83,16 +89,19 @@ impl Scenario {
         let world = WorldSpec::from_toml_file(&world_path)
             .map_err(|e| cx.err("world", format!("cannot load world `{}`: {e}", file.world)))?;
         let built = World::from_spec(&world).map_err(|e| cx.err("world", e.to_string()))?;
-        if !(file.duration.is_finite() && file.duration > 0.0) {
-            return Err(cx.err("duration", format!("must be positive, got {}", file.duration)));
+        if !(file.duration > 0.0 && file.duration <= MAX_DURATION) {
+            return Err(cx.err("duration", format!("must lie in (0, {MAX_DURATION:e}] s, got {:e}", file.duration)));
         }
         let dt = file.dt.unwrap_or(0.01);
-        if !(dt > 0.0 && dt <= 0.1) {
-            return Err(cx.err("dt", format!("must lie in (0, 0.1] s, got {dt}")));
+        if !(MIN_DT..=0.1).contains(&dt) {
+            return Err(cx.err("dt", format!("must lie in [{MIN_DT}, 0.1] s, got {dt:e}")));
         }
         let truth_resolution = file.truth_resolution.unwrap_or(0.05);
-        if !(truth_resolution > 0.0 && truth_resolution.is_finite()) {
-            return Err(cx.err("truth_resolution", "must be positive"));
+        let (lo, hi) = (mrslam_core::map_io::MIN_RESOLUTION, mrslam_core::map_io::MAX_RESOLUTION);
+        if !(lo..=hi).contains(&truth_resolution) {
+            return Err(
+                cx.err("truth_resolution", format!("must be between {lo} and {hi} m, got {truth_resolution:e}"))
+            );
         }
         // A run merges two maps, so it needs two robots at least; a team may be one robot (a study's baseline).
         let team = file.team.as_ref().map(|t| team::resolve_team(&cx, t)).transpose()?;
@@ -354,6 +363,31 @@ mod tests {
         let e = two_rooms(|t| t[..t.rfind("[[robots]]").unwrap()].to_string()).unwrap_err();
         assert_eq!(e.field, "robots", "{e}");
         assert_eq!(e.message, "need at least two robots (a merge takes two maps), found 1");
+    }
+
+    #[test]
+    fn absurd_times_coordinates_and_names_are_refused_naming_the_line() {
+        let refused = |from: &str, to: &str, field: &str, needle: &str| {
+            let text = std::cell::RefCell::new(String::new());
+            let e = two_rooms(|t| {
+                *text.borrow_mut() = t.replacen(from, to, 1);
+                text.borrow().clone()
+            })
+            .unwrap_err();
+            let last = to.lines().last().unwrap_or(to);
+            assert_eq!((e.field.as_str(), e.line), (field, line_holding(&text.borrow(), last)), "{e}");
+            assert!(e.message.contains(needle), "{e}");
+            assert!(e.to_string().len() < 300, "{e}");
+        };
+        refused("duration = 180.0", "duration = 180.0\ndt = 1e-300", "dt", "must lie in [0.0001, 0.1] s");
+        refused("duration = 180.0", "duration = 1e300", "duration", "must lie in (0, 1e6] s");
+        let start = "start = \"start_prawn\"";
+        refused(start, "start = { x = 1e300, y = 2.2, theta = 0.0 }", "robots[1].start", "within 1e7 m of 0");
+        refused(start, "start = [1.0, 2.2, inf]", "robots[1].start", "finite number");
+        refused("[9.4, 2.0]", "[1e300, 2.0]", "robots[1].route[2]", "within 1e7 m of 0");
+        for name in ["truth", "merged_sift", "overlay_rmap", "", "../up", ".hidden"] {
+            refused("name = \"prawn\"", &format!("name = \"{name}\""), "robots[1].name", name);
+        }
     }
 
     #[test]

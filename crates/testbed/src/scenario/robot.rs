@@ -2,6 +2,7 @@
 
 use super::error::{Ctx, ScenarioError, apply};
 use super::file::{LidarRef, PointRef, PoseRef, RobotFile, SlamFile};
+use mrslam_core::map_io;
 use mrslam_core::{Pose2, pose};
 use mrslam_sim::{EncoderParams, LidarModel, RobotModel, SlipParams, World, WorldSpec, odometry_fit};
 use mrslam_slam::SlamParams;
@@ -46,12 +47,45 @@ pub struct RobotSetup {
 }
 
 pub(super) fn resolve_pose(cx: &Ctx, field: &str, r: &PoseRef, world: &WorldSpec) -> Result<Pose2, ScenarioError> {
-    match r {
+    let (x, y, t) = match r {
         PoseRef::Named(n) => {
-            world.named_pose(n).ok_or_else(|| cx.err(field, format!("no point named `{n}` in the world")))
+            return world.named_pose(n).ok_or_else(|| cx.err(field, format!("no point named `{n}` in the world")));
         }
-        PoseRef::Xyt([x, y, t]) => Ok(pose(*x, *y, *t)),
-        PoseRef::Table(p) => Ok(p.pose()),
+        PoseRef::Xyt([x, y, t]) => (*x, *y, *t),
+        PoseRef::Table(p) => (p.x, p.y, p.theta),
+    };
+    check_coordinates(cx, field, &[x, y, t])?;
+    Ok(pose(x, y, t))
+}
+
+/// Why a robot's `name` cannot name its files in a run's folder (`NAME.yaml`, `.pgm`, `.png`), if it cannot: empty,
+/// a path rather than a name, or one of the run's own files (`truth`, `merged_*`, `overlay_*`).
+fn check_name(name: &str) -> Result<(), String> {
+    if name.trim().is_empty() {
+        return Err("a robot needs a name (its map is written as NAME.yaml)".into());
+    }
+    if name.contains(['/', '\\', '\0']) || name.starts_with('.') {
+        return Err(format!("`{name}`: a robot's name is a file name, so it may hold no / or \\ and not start with ."));
+    }
+    let ours = name == "truth" || name.starts_with("merged_") || name.starts_with("overlay_");
+    if ours {
+        return Err(format!(
+            "`{name}`: the run writes its own files under this name (truth.yaml, merged_ALGORITHM.yaml, \
+             overlay_ALGORITHM.png); name the robot otherwise"
+        ));
+    }
+    Ok(())
+}
+
+/// Refuses a coordinate that is not a number or lies further than the world reader's bound from 0 (a typo, which
+/// would otherwise be printed with hundreds of digits in the error that follows).
+fn check_coordinates(cx: &Ctx, field: &str, values: &[f64]) -> Result<(), ScenarioError> {
+    let bound = mrslam_sim::MAX_WORLD_COORDINATE;
+    match values.iter().find(|v| !(v.is_finite() && v.abs() <= bound)) {
+        Some(v) => {
+            Err(cx.err(field, format!("{v:e}: every coordinate must be a finite number within {bound:e} m of 0")))
+        }
+        None => Ok(()),
     }
 }
 
@@ -63,6 +97,7 @@ pub(super) fn resolve_robot(
     world: &World,
 ) -> Result<RobotSetup, ScenarioError> {
     let f = |name: &str| format!("robots[{i}].{name}");
+    check_name(&r.name).map_err(|message| cx.err(f("name"), message))?;
     let model = RobotModel::preset(&r.model).ok_or_else(|| {
         let names = RobotModel::PRESETS.join(", ");
         cx.err(f("model"), format!("unknown robot model `{}` (expected one of {names})", r.model))
@@ -127,6 +162,7 @@ pub(super) fn resolve_robot(
             PointRef::Xy([x, y]) => Point2::new(*x, *y),
             PointRef::Table(p) => Point2::new(p.x, p.y),
         };
+        check_coordinates(cx, &field, &[p.x, p.y])?;
         if outside(&p) {
             return Err(cx.err(&field, format!("waypoint ({:.2}, {:.2}) lies outside the world ({bounds})", p.x, p.y)));
         }
@@ -235,5 +271,11 @@ fn resolve_slam(cx: &Ctx, field: &str, s: &SlamFile, lidar: &LidarModel) -> Resu
     p.map.max_range = p.map.max_range.min(lidar.range_max);
     p.map.max_urange = p.map.max_urange.min(lidar.range_max);
     p.validate().map_err(|e| cx.err(field, e.to_string()))?;
+    let bounds = map_io::MIN_RESOLUTION..=map_io::MAX_RESOLUTION;
+    if !bounds.contains(&p.map.delta) {
+        let (lo, hi) = bounds.into_inner();
+        let message = format!("map.delta {}: must be between {lo} and {hi} metres per pixel", p.map.delta);
+        return Err(cx.err(field, message));
+    }
     Ok(p)
 }
