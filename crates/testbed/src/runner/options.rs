@@ -13,8 +13,9 @@ use std::collections::BTreeMap;
 #[derive(Debug, thiserror::Error)]
 pub enum RunError {
     /// The simulator refused something (e.g. a start inside an obstacle).
+    // Not `#[from]`: that makes the error its own source too, and a chain printer says it twice.
     #[error("simulator: {0}")]
-    Sim(#[from] SimError),
+    Sim(SimError),
     /// A SLAM filter refused its input or parameters.
     #[error("SLAM of robot `{robot}`: {error}")]
     Slam {
@@ -29,6 +30,12 @@ pub enum RunError {
     /// The scenario is not one a run can take (its fields are public, so it may not come from a file).
     #[error("scenario: {0}")]
     Scenario(String),
+}
+
+impl From<SimError> for RunError {
+    fn from(e: SimError) -> Self {
+        RunError::Sim(e)
+    }
 }
 
 /// Options of a run that are not part of the scenario.
