@@ -13,8 +13,11 @@ use std::path::Path;
 /// What a run's report says that must not depend on the recording (wall-clock times left out).
 fn outcome(r: &RunReport) -> String {
     let team = r.team.as_ref().unwrap();
-    let attempts: Vec<MergeAttempt> =
-        team.attempts.iter().map(|a| MergeAttempt { time_ms: 0.0, ..a.clone() }).collect();
+    let attempts: Vec<MergeAttempt> = team
+        .attempts
+        .iter()
+        .map(|a| MergeAttempt { time_ms: 0.0, stage_ms: Default::default(), ..a.clone() })
+        .collect();
     let robots: Vec<(f64, f64, usize)> =
         r.robots.values().map(|x| (x.distance_m, x.slam_rmse_m, x.processed)).collect();
     format!("{:?} {:?} {:?} {} {:?} {robots:?}", team.coverage, attempts, team.plans, team.bytes_exchanged, r.sim_s)

@@ -28,8 +28,8 @@ python3 - "$out" ${seeds[@]} <<'PY'
 import json, os, statistics, sys
 
 out, seeds = sys.argv[1], sys.argv[2:]
-print("| variant | seed | at | robots | known m² | decided by | accepted / correct | time in the run |")
-print("|---|---|---|---|---|---|---|---|")
+print("| variant | seed | at | robots | known m² | decided by | accepted / correct | time in the run | sift / sift+boundary / correlative |")
+print("|---|---|---|---|---|---|---|---|---|")
 times = {"near": [], "everywhere": []}
 for variant in times:
     for s in seeds:
@@ -37,8 +37,10 @@ for variant in times:
         for a in report["team"]["attempts"]:
             verdict = "yes / yes" if a["correct"] else ("yes / **no**" if a["accepted"] else "no")
             known = " / ".join(f"{k:.0f}" for k in a["known_m2"])
+            st = a.get("stage_ms", {})
+            stages = " / ".join(f"{st[k]:.0f}" if k in st else "-" for k in ("sift", "sift+boundary", "correlative"))
             print(f"| {variant} | {s} | {a['time_s']:.0f} s | {' and '.join(a['robots'])} | {known} | {a['stage']} | "
-                  f"{verdict} | {a['time_ms']:.0f} ms |")
+                  f"{verdict} | {a['time_ms']:.0f} ms | {stages} ms |")
             times[variant].append(a["time_ms"])
 print()
 for variant, t in times.items():

@@ -209,6 +209,10 @@ pub struct MergeAttempt {
     pub reason: Option<String>,
     /// Merge wall time, milliseconds.
     pub time_ms: f64,
+    /// The wall time of each stage the merge ran (the cascade's `sift`, `sift+boundary`, `correlative`; a lone
+    /// merger's steps), milliseconds.
+    #[serde(default)]
+    pub stage_ms: BTreeMap<String, f64>,
 }
 
 /// A joined team's frontier assignment at one moment.

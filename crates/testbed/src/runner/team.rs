@@ -295,6 +295,13 @@ impl<'s> Teams<'s> {
                 stage: out.report.stage.clone(),
                 reason: out.report.reason.clone(),
                 time_ms: out.report.time_ms,
+                stage_ms: out
+                    .report
+                    .timings_ms
+                    .iter()
+                    .filter(|(k, _)| !k.contains('/'))
+                    .map(|(k, v)| (k.clone(), *v))
+                    .collect(),
             });
             if let (true, Some(x)) = (out.report.accepted, out.report.transform) {
                 let t_ra_rb = x.to_pose();
