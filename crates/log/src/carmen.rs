@@ -54,6 +54,8 @@ pub fn parse(reader: impl BufRead, path: &Path, options: &ReadOptions) -> Result
     let mut reader = reader.take(options.max_bytes.saturating_add(1));
     let mut bytes = Vec::new();
     let mut line_no = 0;
+    // And what the records hold in memory, under the same bound: parsed, a log takes more room than its text.
+    let mut held: u64 = 0;
     loop {
         bytes.clear();
         let line_limit = (options.max_line_bytes as u64).saturating_add(1);
@@ -127,21 +129,27 @@ pub fn parse(reader: impl BufRead, path: &Path, options: &ReadOptions) -> Result
                 let laser = if rear_laser { &rear } else { &front };
                 let record = parse_old_laser(&rest, laser, kind, rear_laser, source).map_err(err)?;
                 order.scan(record.scan.stamp, &record.source).map_err(stepped_back)?;
+                held += scan_bytes(&record);
                 log.scans.push(record);
             }
             "ROBOTLASER1" => {
                 let record = parse_robot_laser(&rest, kind, source).map_err(err)?;
                 order.scan(record.scan.stamp, &record.source).map_err(stepped_back)?;
+                held += scan_bytes(&record);
                 log.scans.push(record);
             }
             "ODOM" => {
                 let v = numbers(&rest, 7, "x y theta tv rv accel ipc_timestamp").map_err(err)?;
                 let odometry = Odometry { stamp: v[6], pose: pose(v[0], v[1], v[2]) };
                 log.odometry.push(OdometryRecord { odometry, forward_speed: v[3] });
+                held += std::mem::size_of::<OdometryRecord>() as u64;
                 order.odometry(v[6], &source).map_err(stepped_back)?;
             }
             k if k.starts_with('#') => *log.skipped.entry("comment".into()).or_default() += 1,
             k => *log.skipped.entry(k.to_string()).or_default() += 1,
+        }
+        if held > options.max_bytes {
+            return Err(LogError::TooMuchHeld { path: path.to_path_buf(), line: line_no, limit: options.max_bytes });
         }
     }
     order.finish(&mut log);
@@ -173,6 +181,11 @@ fn parse_count(fields: &[&str], at: usize, what: &str) -> Result<usize, String> 
         return Err(format!("{what} {n} is implausibly large"));
     }
     Ok(n)
+}
+
+/// The memory a scan's record holds: the record, its ranges and its sensor's name.
+fn scan_bytes(record: &ScanRecord) -> u64 {
+    (std::mem::size_of::<ScanRecord>() + 4 * record.scan.ranges.len() + record.sensor.len()) as u64
 }
 
 fn parse_old_laser(f: &[&str], laser: &OldLaser, kind: &str, rear: bool, source: Source) -> Result<ScanRecord, String> {
@@ -303,7 +316,8 @@ ODOM 0.0 0.0 0.0 0.0 0.0 0.0 1.0 host 1.0
 
     #[test]
     fn a_log_larger_than_the_bound_is_refused() {
-        let line = "ODOM 0 0 0 0 0 0 1.0 h 1\n";
+        // Lines as loggers write them, longer than the record each becomes.
+        let line = "ODOM 0.000000 0.000000 0.000000 0.000000 0.000000 0.000000 1.000000 nohost 1.000000\n";
         let text = line.repeat(100);
         let opts = ReadOptions { max_bytes: 1000, ..ReadOptions::default() };
         let e = parse(text.as_bytes(), Path::new("big.clf"), &opts).unwrap_err();
@@ -312,6 +326,16 @@ ODOM 0.0 0.0 0.0 0.0 0.0 0.0 1.0 host 1.0
         // Exactly the bound is read.
         let exact = ReadOptions { max_bytes: text.len() as u64, ..ReadOptions::default() };
         assert_eq!(parse(text.as_bytes(), Path::new("big.clf"), &exact).unwrap().odometry.len(), 1);
+        // Scans whose ranges take more room parsed than as text stop at the bound on what the records hold, before
+        // the bound on the text: 1000 ranges of `1 ` are 2000 bytes of text and 4000 held.
+        let scan = format!("FLASER 1000 {}0 0 0 0 0 0 1.0 h 1\n", "1 ".repeat(1000));
+        let two = scan.clone() + &scan.replace(" 1.0 h", " 2.0 h");
+        let bound = ReadOptions { max_bytes: 5000, ..ReadOptions::default() };
+        assert!(two.len() < 5000);
+        let e = parse(two.as_bytes(), Path::new("wide.clf"), &bound).unwrap_err();
+        assert!(matches!(e, LogError::TooMuchHeld { line: 2, .. }), "{e}");
+        assert!(e.to_string().contains("wide.clf: its records would hold more than"), "{e}");
+        assert_eq!(parse(scan.as_bytes(), Path::new("one.clf"), &bound).unwrap().scans.len(), 1);
         // Endless empty lines (short lines, so the line bound never trips) stop at the total bound.
         let lines = std::io::BufReader::new(std::io::repeat(b'\n'));
         let e = parse(lines, Path::new("n.clf"), &ReadOptions { max_bytes: 1 << 20, ..opts }).unwrap_err();

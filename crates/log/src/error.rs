@@ -57,6 +57,20 @@ pub enum LogError {
         /// Whether the file is gzipped.
         compressed: bool,
     },
+    /// Records that would hold more than [`ReadOptions::max_bytes`](crate::ReadOptions::max_bytes) in memory:
+    /// a scan's ranges take 4 bytes each, more than the two characters `1 ` of text.
+    #[error(
+        "{path}: its records would hold more than {} in memory by line {line}: refused before it exhausts memory",
+        size_text(*.limit)
+    )]
+    TooMuchHeld {
+        /// File at fault.
+        path: PathBuf,
+        /// The line read when the bound was passed.
+        line: usize,
+        /// The bound, bytes.
+        limit: u64,
+    },
     /// A recorded bag that cannot be read as asked: cut off, a chunk that does not decompress, no scan topic
     /// or several without a choice.
     #[error("{path}: {message}")]
