@@ -23,7 +23,7 @@ use mrslam_core::toml_lines::TomlLines;
 use mrslam_merge::Algorithm;
 use mrslam_sim::World;
 use mrslam_testbed::runner::{RunOptions, run};
-use mrslam_testbed::scenario::Scenario;
+use mrslam_testbed::scenario::{ControllerKind, Scenario};
 use rayon::prelude::*;
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
@@ -114,6 +114,10 @@ impl Sweep {
         if file.seeds.is_empty() {
             return Err(at(line_of("seeds"), "seeds: give at least one seed".into()));
         }
+        if let Some(k) = (1..file.seeds.len()).find(|&k| file.seeds[..k].contains(&file.seeds[k])) {
+            // The same seed twice runs the same trial twice: its results would count twice in the summary.
+            return Err(at(line_of("seeds"), format!("seeds[{k}] = {}: given twice", file.seeds[k])));
+        }
         let mut vary = Vec::new();
         for (i, v) in file.vary.iter().enumerate() {
             let f = |name: &str| format!("vary[{i}].{name}");
@@ -146,6 +150,24 @@ impl Sweep {
                     v.values[k]
                 );
                 return Err(at(line_of(&field), message));
+            }
+            // A field the robot's controller does not read would make every variant the same run.
+            let controller = scenario.robots[robot].controller;
+            if controller == ControllerKind::Idle || (field != Field::Speed && controller != ControllerKind::Waypoints)
+            {
+                let message = format!(
+                    "{}: robot `{}` is driven by its `{}` controller, which does not read `{}`: every variant would be \
+                     the same run",
+                    f("field"),
+                    v.robot,
+                    match controller {
+                        ControllerKind::Waypoints => "waypoints",
+                        ControllerKind::Explore => "explore",
+                        ControllerKind::Idle => "idle",
+                    },
+                    v.field
+                );
+                return Err(at(line_of(&f("field")), message));
             }
             if field != Field::Speed && scenario.robots[robot].route.is_empty() {
                 let message = format!("{}: robot `{}` has no route whose end could move", f("field"), v.robot);
@@ -319,5 +341,16 @@ mod tests {
         let e = sweep_error(&format!("{head}{far}"));
         assert!(e.contains("sweep.toml:7: vary[0].values[0] = 1e300: must be a finite number within 1e7"), "{e}");
         assert!(e.len() < 300, "{e}");
+        // A seed given twice would count one trial twice.
+        let twice = head.replace("seeds = [1]", "seeds = [1, 2, 1]");
+        let e = sweep_error(&format!("{twice}{}", vary("experia", "[0.3]")));
+        assert!(e.contains("sweep.toml:3: seeds[2] = 1: given twice"), "{e}");
+        // A route's end on a robot that explores (it has no route to follow) varies nothing.
+        let explorers = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenarios/team_two_rooms.toml");
+        let head = head.replace("\"SCENARIO\"", &format!("{:?}", explorers.display().to_string()));
+        let robot = Scenario::from_file(&explorers).unwrap().robots[0].name.clone();
+        let far = format!("[[vary]]\nrobot = \"{robot}\"\nfield = \"route_end_x\"\nvalues = [3.0]\n");
+        let e = sweep_error(&format!("{head}{far}"));
+        assert!(e.contains("sweep.toml:6: vary[0].field: robot") && e.contains("`explore` controller"), "{e}");
     }
 }
