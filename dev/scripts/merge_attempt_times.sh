@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
-# What an online merge attempt costs: a team scenario run for each seed as shipped (attempts search near the
-# robots' contact) and with `search_near_contact = false` (every transform, as `mrslam merge` of two files);
-# every attempt of every run listed from report.json (time in the run, where the robots' SLAMs share the cores,
-# the stage that decided, the two teams' known areas), then the median of each variant.
+# What an online merge attempt costs: a team scenario run for each seed with its attempts' correlative search kept
+# near the robots' contact (`search_near_contact = true`) and searching every transform (`false`, the default;
+# the gate holds the contact's bound either way); every attempt of every run listed from report.json (time in
+# the run, where the robots' SLAMs share the cores, the stage that decided, the two teams' known areas, each
+# stage's time), then the median of each variant.
 #
 # Usage: dev/scripts/merge_attempt_times.sh SCENARIO.toml OUT [SEEDS...]   (default seeds 0 1 2)
 # Uses target/debug/mrslam (the dev profile is optimised) unless MRSLAM names another binary; reuses a run whose
@@ -14,15 +15,17 @@ shift 2
 seeds=("${@:-0 1 2}")
 bin=${MRSLAM:-target/debug/mrslam}
 mkdir -p "$out"
-# The variant: the same scenario beside the original (its world path is relative to it), the search unbounded.
+# The variants: the same scenario beside the original (its world path is relative to it), the setting added.
 dir=$(dirname "$scenario")
 name=$(basename "$scenario" .toml)
-everywhere="$dir/.$name-everywhere.toml"
-trap 'rm -f "$everywhere"' EXIT
-sed 's/^\[team\]$/[team]\nsearch_near_contact = false/' "$scenario" > "$everywhere"
+trap 'rm -f "$dir/.$name-near.toml" "$dir/.$name-everywhere.toml"' EXIT
+sed 's/^\[team\]$/[team]\nsearch_near_contact = true/' "$scenario" > "$dir/.$name-near.toml"
+sed 's/^\[team\]$/[team]\nsearch_near_contact = false/' "$scenario" > "$dir/.$name-everywhere.toml"
 for s in ${seeds[@]}; do
-  [ -f "$out/near-s$s/report.json" ] || "$bin" run "$scenario" --seed "$s" --out "$out/near-s$s" --quiet > /dev/null
-  [ -f "$out/everywhere-s$s/report.json" ] || "$bin" run "$everywhere" --seed "$s" --out "$out/everywhere-s$s" --quiet > /dev/null
+  for variant in near everywhere; do
+    [ -f "$out/$variant-s$s/report.json" ] ||
+      "$bin" run "$dir/.$name-$variant.toml" --seed "$s" --out "$out/$variant-s$s" --quiet > /dev/null
+  done
 done
 python3 - "$out" ${seeds[@]} <<'PY'
 import json, os, statistics, sys

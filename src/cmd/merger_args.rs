@@ -67,9 +67,9 @@ pub struct MergerArgs {
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
     /// Two robots that met, `XA,YA,XB,YB,WITHIN`: robot a at (XA, YA) in map a's frame and robot b at (XB, YB)
-    /// in map b's, at most WITHIN metres apart (a radio's range, plus their pose error). The search keeps to the
-    /// transforms that put them so, and the gate refuses any other, as online merges of robots in contact do
-    /// (two maps only).
+    /// in map b's, at most WITHIN metres apart (a radio's range, plus their pose error). The gate refuses any
+    /// transform that puts them farther apart, as it does for the online merges of robots in contact (two maps
+    /// only).
     #[arg(long, value_name = "XA,YA,XB,YB,WITHIN", value_parser = contact, allow_hyphen_values = true)]
     pub contact: Option<Contact>,
 }
@@ -124,7 +124,7 @@ fn contact(s: &str) -> Result<Contact, String> {
         s.split(',').map(|x| x.trim().parse::<f64>().map_err(|e| format!("`{x}`: {e}"))).collect::<Result<_, _>>()?;
     match v[..] {
         [xa, ya, xb, yb, within] if v.iter().all(|x| x.is_finite() && x.abs() <= 1e6) && within > 0.0 => {
-            Ok(Contact { a: Point2::new(xa, ya), b: Point2::new(xb, yb), within_m: within })
+            Ok(Contact { a: Point2::new(xa, ya), b: Point2::new(xb, yb), within_m: within, search_within: false })
         }
         [_, _, _, _, within] if within <= 0.0 => Err(format!("WITHIN must be above 0 metres, got {within}")),
         [_, _, _, _, _] => Err("the numbers must be finite metres within ±1e6".into()),

@@ -2,9 +2,9 @@
 //!
 //! Robots that exchange maps over a radio of range r are at most r apart at that moment (two robots in contact,
 //! Dudek-style rendezvous). Each knows its own pose in its own map, so an answer `T_a_b` that puts b's robot
-//! farther than r (plus the robots' localisation error) from a's is not where the maps meet: the search need
-//! not look there, and the gate refuses it. `mrslam merge` of two files knows no contact and searches every
-//! transform.
+//! farther than r (plus the robots' localisation error) from a's is not where the maps meet: the gate refuses
+//! it, and, when asked ([`Contact::search_within`]), the correlative search does not look there. `mrslam merge`
+//! of two files knows no contact unless `--contact` gives one.
 
 use mrslam_core::Pose2;
 use nalgebra::{Point2, Rotation2};
@@ -18,12 +18,17 @@ pub struct Contact {
     pub b: Point2<f64>,
     /// Largest distance between them, metres: the link's range plus the error of the robots' poses.
     pub within_m: f64,
+    /// Whether the correlative searches keep to the translations within reach (faster), or search every one
+    /// and leave the bound to the gate. Off by default where it is offered: a search kept within reach no
+    /// longer sees the answers elsewhere that tell a self-similar pair is ambiguous, and in the FR079 team
+    /// study one such pair merged 178° wrong within reach (the gate alone refused it).
+    pub search_within: bool,
 }
 
 impl Contact {
     /// The same contact seen from b: for merging b with a.
     pub fn swapped(&self) -> Contact {
-        Contact { a: self.b, b: self.a, within_m: self.within_m }
+        Contact { a: self.b, b: self.a, ..*self }
     }
 
     /// How far apart `t_a_b` puts the two robots, metres.
@@ -65,7 +70,7 @@ mod tests {
 
     #[test]
     fn a_transform_that_puts_the_robots_apart_is_refused() {
-        let c = Contact { a: Point2::new(1.0, 2.0), b: Point2::new(0.0, 0.0), within_m: 5.0 };
+        let c = Contact { a: Point2::new(1.0, 2.0), b: Point2::new(0.0, 0.0), within_m: 5.0, search_within: true };
         assert!(c.refusal(&pose(1.0, 2.0, 0.7)).is_none());
         assert!(c.refusal(&pose(5.0, 2.0, 0.0)).is_none());
         let far = c.refusal(&pose(7.0, 2.0, 0.0)).unwrap();
@@ -79,7 +84,7 @@ mod tests {
     fn the_offsets_hold_every_translation_that_keeps_the_robots_in_range() {
         let origin_a = pose(-3.0, 4.0, 0.3);
         let centroid = Point2::new(2.0, -1.0);
-        let c = Contact { a: Point2::new(1.5, 0.5), b: Point2::new(4.0, 2.0), within_m: 3.0 };
+        let c = Contact { a: Point2::new(1.5, 0.5), b: Point2::new(4.0, 2.0), within_m: 3.0, search_within: true };
         let cell = 0.2;
         for theta in [0.0, 0.8, -2.5] {
             let [x0, x1, y0, y1] = c.offsets(&origin_a, &centroid, theta, cell);

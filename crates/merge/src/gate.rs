@@ -93,8 +93,9 @@ pub(crate) fn rival_reason(
             h.transform = refine(a, walls_b, &h.transform, &p.refine);
         }
         let apart = max_displacement(walls_b, &chosen.hypothesis.transform, &h.transform);
-        // A rival that puts robots in contact out of each other's reach is no rival.
-        if apart <= p.verify.ambiguity_shift_m || p.contact.is_some_and(|c| c.refusal(&h.transform).is_some()) {
+        // A rival out of the robots' reach still counts: it says the maps are alike elsewhere too, and an answer
+        // within reach may then be a coincidence (the FR079 study, 2026-12-07).
+        if apart <= p.verify.ambiguity_shift_m {
             continue;
         }
         let agr = agreement_within(a, b, &h.transform, 1);

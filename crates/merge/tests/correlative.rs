@@ -105,20 +105,23 @@ fn robots_in_contact_are_merged_where_they_can_have_met_and_nowhere_else() {
         let pair = cut_pair(&map, &PairSpec { overlap, max_shift_m: 4.0, rotate: true }, seed);
         let (w, h, res) = (pair.a.width() as f64, pair.a.height() as f64, pair.a.resolution());
         let free = pair.a.origin() * Point2::new(0.5 * w * res, 0.5 * h * res);
-        let contact = |apart: f64| Contact {
+        let contact = |apart: f64, search_within: bool| Contact {
             a: free,
             b: pair.t_a_b.inverse() * (free + Vector2::new(apart, 0.0)),
             within_m: 8.0,
+            search_within,
         };
-        let near =
-            merge(&merger, &pair.a, &pair.b, &MergeParams { contact: Some(contact(3.0)), ..MergeParams::default() });
-        let r = &near.report;
-        assert!(r.accepted, "seed {seed}: refused: {:?}", r.reason);
-        let t = r.transform.expect("an accepted merge has a transform");
-        let (deg, m) = error(t.x, t.y, t.theta, &pair.t_a_b);
-        assert!(deg < 0.5 && m < 0.1, "seed {seed}: off by {deg:.2} deg, {m:.3} m");
-        let far =
-            merge(&merger, &pair.a, &pair.b, &MergeParams { contact: Some(contact(20.0)), ..MergeParams::default() });
-        assert!(!far.report.accepted, "seed {seed}: merged out of the robots' reach: {:?}", far.report);
+        // Searched within reach, and everywhere with the gate alone holding the bound.
+        for search_within in [true, false] {
+            let with = |c: Contact| MergeParams { contact: Some(c), ..MergeParams::default() };
+            let near = merge(&merger, &pair.a, &pair.b, &with(contact(3.0, search_within)));
+            let r = &near.report;
+            assert!(r.accepted, "seed {seed} {search_within}: refused: {:?}", r.reason);
+            let t = r.transform.expect("an accepted merge has a transform");
+            let (deg, m) = error(t.x, t.y, t.theta, &pair.t_a_b);
+            assert!(deg < 0.5 && m < 0.1, "seed {seed} {search_within}: off by {deg:.2} deg, {m:.3} m");
+            let far = merge(&merger, &pair.a, &pair.b, &with(contact(20.0, search_within)));
+            assert!(!far.report.accepted, "seed {seed} {search_within}: merged out of reach: {:?}", far.report);
+        }
     }
 }

@@ -121,7 +121,7 @@ impl CorrelativeMerger {
             }
             let mut window =
                 Window { x0: -x1, x1: field.width as i32 - 1 - x0, y0: -y1, y1: field.height as i32 - 1 - y0 };
-            if let Some(c) = &self.contact {
+            if let Some(c) = self.contact.filter(|c| c.search_within) {
                 let [cx0, cx1, cy0, cy1] = c.offsets(a.origin(), &scan.centroid, j as f64 * step, cell);
                 window = Window {
                     x0: window.x0.max(cx0),

@@ -67,9 +67,10 @@ pub struct TeamSetup {
     /// m² (0: from the first scan). Maps of a scan or two match a corridor's other doors as well as the right
     /// ones; the correlative stage asks for 100 m² of shared known space for the same reason.
     pub min_known_m2: f64,
-    /// Whether an online merge searches only the transforms that put the two robots in contact within the range
-    /// of each other (each where its SLAM puts it on its team's map); false searches every transform, as `mrslam
-    /// merge` of two files does.
+    /// Whether an online merge's correlative search looks only at the transforms that put the two robots in
+    /// contact within the range of each other (each where its SLAM puts it on its team's map). The gate refuses
+    /// the others either way. Off by default: about 10 % faster, but blind to the answers elsewhere that show a
+    /// self-similar pair ambiguous (one false merge in the FR079 study with it on, none with it off).
     pub search_near_contact: bool,
 }
 
@@ -84,7 +85,7 @@ impl Default for TeamSetup {
             coverage_period: 2.0,
             beta: 1.0,
             min_known_m2: 0.0,
-            search_near_contact: true,
+            search_near_contact: false,
         }
     }
 }
