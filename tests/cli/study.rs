@@ -193,7 +193,18 @@ fn an_interrupted_study_keeps_its_finished_trials_and_resumes() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("study");
     let results = out.join("results.csv");
-    let mut child = study_command(&out, "5", "60", &[]).spawn().unwrap();
+    let mut command = study_command(&out, "5", "60", &[]);
+    // A test run started in the background by a shell without job control inherits SIGINT ignored (POSIX), and
+    // the study, which installs no handler of its own, would pass it on: it gets the default action back.
+    #[cfg(unix)]
+    // SAFETY: between fork and exec only the async-signal-safe `signal` is called.
+    unsafe {
+        std::os::unix::process::CommandExt::pre_exec(&mut command, || {
+            libc::signal(libc::SIGINT, libc::SIG_DFL);
+            Ok(())
+        });
+    }
+    let mut child = command.spawn().unwrap();
     // Interrupt as soon as a few trials are written.
     let start = std::time::Instant::now();
     while std::fs::read_to_string(&results).map_or(0, |t| t.lines().count()) < 5 {
