@@ -1,5 +1,6 @@
 //! Laser scans and odometry readings, as a robot's drivers deliver them.
 
+use crate::pose::interpolate;
 use crate::se2::Pose2;
 use nalgebra::Point2;
 
@@ -79,10 +80,35 @@ pub struct Odometry {
     pub pose: Pose2,
 }
 
+impl Odometry {
+    /// The pose at `t` between this reading and a later one `next`, interpolated; at either reading's own stamp
+    /// that reading's pose as it is (through the interpolation its heading would come back an ulp off, and a
+    /// particle filter turns an ulp into another map).
+    pub fn towards(&self, next: &Odometry, t: f64) -> Pose2 {
+        if t == self.stamp || next.stamp <= self.stamp {
+            self.pose
+        } else if t == next.stamp {
+            next.pose
+        } else {
+            interpolate(&self.pose, &next.pose, (t - self.stamp) / (next.stamp - self.stamp))
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::se2::pose;
+
+    #[test]
+    fn a_pose_between_readings_is_either_reading_as_it_is_at_its_stamp() {
+        // 0.173078: a heading whose trip through an interpolation comes back an ulp off.
+        let a = Odometry { stamp: 1.0, pose: pose(0.0, 0.0, -0.173078) };
+        let b = Odometry { stamp: 2.0, pose: pose(1.0, 0.0, 0.280918) };
+        assert_eq!((a.towards(&b, 1.0), a.towards(&b, 2.0)), (a.pose, b.pose));
+        assert!((crate::Xyt::from_pose(&a.towards(&b, 1.5)).x - 0.5).abs() < 1e-12);
+        assert_eq!(a.towards(&Odometry { stamp: 1.0, ..b }, 1.0), a.pose, "two readings of one stamp");
+    }
 
     fn scan(ranges: Vec<f32>) -> LaserScan {
         LaserScan {

@@ -11,7 +11,6 @@ use crate::robot_speed::faster_than_a_robot;
 use crate::sensor_log::{OdometryRecord, ScanRecord, SensorLog};
 use crate::source::Source;
 use mrslam_core::Odometry;
-use mrslam_core::pose::interpolate;
 
 /// A sensor reading stamped too long before one above it (two logs joined, or a clock reset).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -210,16 +209,7 @@ pub fn odometry_at_scans(log: &mut SensorLog, source: OdometrySource, latency: f
             }
             let (a, b) = (&odometry[k].odometry, &odometry[k + 1].odometry);
             if a.stamp <= t && t <= b.stamp {
-                // A scan stamped at a reading takes that reading as it is: through the interpolation its
-                // heading would come back an ulp off, and the filter turns an ulp into another map.
-                let pose = if t == a.stamp {
-                    a.pose
-                } else if t == b.stamp {
-                    b.pose
-                } else {
-                    interpolate(&a.pose, &b.pose, (t - a.stamp) / (b.stamp - a.stamp))
-                };
-                s.odometry = Odometry { stamp: s.scan.stamp, pose };
+                s.odometry = Odometry { stamp: s.scan.stamp, pose: a.towards(b, t) };
                 interpolated += 1;
             }
         }

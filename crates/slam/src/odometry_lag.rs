@@ -2,7 +2,7 @@
 //!
 //! A log without an odometry stream carries one odometry pose per scan line, written by a logger that took the
 //! last reading it had: on ACES read without its ODOM lines the scan lines' odometry is the robot's pose of
-//! 0.11 s before the scan (half of the 5.4 Hz scan period), and a turn then reaches the filter a tenth of a
+//! about 0.12 s before the scan (compared with its ODOM lines), and a turn then reaches the filter a tenth of a
 //! second late. There is no clock to compare with, but the scans saw the turn when it happened: each scan's
 //! heading change, matched against the scans before it, against the odometry's heading change over the same
 //! interval shifted by a lag; the lag that explains the scans best is the odometry's. The odometry of each scan
@@ -12,7 +12,7 @@
 use crate::motion::MotionModel;
 use crate::params::SlamParams;
 use crate::scan_odometry::{OdometryStep, ScanOdometry};
-use mrslam_core::pose::{interpolate, normalize_angle};
+use mrslam_core::pose::normalize_angle;
 use mrslam_core::{LaserScan, Odometry, Pose2, Xyt};
 
 /// Scans matched to estimate the lag, at most: the first of the log (a few minutes of driving; the estimate
@@ -139,11 +139,8 @@ pub fn retime(odometry: &mut [Odometry], lag: f64) {
         }
         o.pose = match original.get(k + 1) {
             _ if t <= original[0].stamp => original[0].pose,
-            Some(b) if b.stamp > original[k].stamp => {
-                let a = &original[k];
-                interpolate(&a.pose, &b.pose, (t - a.stamp) / (b.stamp - a.stamp))
-            }
-            _ => original[k].pose,
+            Some(b) => original[k].towards(b, t),
+            None => original[k].pose,
         };
     }
 }
