@@ -70,7 +70,7 @@ pub fn run(args: MergeArgs) -> Result<ExitCode> {
     }
     let a = super::map::read_yaml_map(&args.a)?;
     let b = super::map::read_yaml_map(&args.b)?;
-    super::merge_many::refuse_same_maps(&[args.a.as_path(), args.b.as_path()], &[&a, &b])?;
+    super::merge_many::refuse_unmergeable_pairs(&[args.a.as_path(), args.b.as_path()], &[&a, &b])?;
     let (name_a, name_b) = pair_names(&args.a, &args.b);
     let (algorithm, seed) = (args.merger.algorithm, args.merger.seed);
     let recording_id = format!("merge-{name_a}-{name_b}-{algorithm}-seed{seed}");

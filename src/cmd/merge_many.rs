@@ -7,7 +7,7 @@ use mrslam_core::Xyt;
 use mrslam_core::map_io;
 use mrslam_core::output::write_file_atomic;
 use mrslam_merge::{MergeParams, Merger, MultiReport, merge_many};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 /// Where the N-map merge's results go.
@@ -22,28 +22,34 @@ pub struct Outputs<'a> {
 /// and maps further apart than this are a wrong file (or a typo'd resolution), not two robots' maps.
 pub const MAX_RESOLUTION_RATIO: f64 = 20.0;
 
-/// Refuses a map given twice among `files` (their maps `maps`, in order): by name, by another path to the same
-/// file, as two YAMLs naming one image, or as a copy holding the same cells (wherever its origin puts them).
-/// Merging a map with itself measures nothing. Also refuses two maps whose resolutions are further apart than
-/// [`MAX_RESOLUTION_RATIO`].
-pub fn refuse_same_maps(files: &[&Path], maps: &[&OccupancyGrid]) -> Result<()> {
-    for (i, (fa, a)) in files.iter().zip(maps).enumerate() {
-        for (fb, b) in files.iter().zip(maps).skip(i + 1) {
-            refuse_same_pair(fa, a, fb, b)?;
+/// Refuses a pair among `files` (their maps `maps`, in order) that cannot be two maps to merge: one map given
+/// twice, by name, by another path to the same file, as two YAMLs naming one image, or as a copy holding the same
+/// cells (wherever its origin puts them), since merging a map with itself measures nothing; or two maps whose
+/// resolutions are further apart than [`MAX_RESOLUTION_RATIO`].
+pub fn refuse_unmergeable_pairs(files: &[&Path], maps: &[&OccupancyGrid]) -> Result<()> {
+    // Each YAML's image, resolved once.
+    let images: Vec<Option<PathBuf>> =
+        files.iter().map(|f| super::paths::read_files(f).get(1).and_then(|i| i.canonicalize().ok())).collect();
+    for (i, ((fa, a), ia)) in files.iter().zip(maps).zip(&images).enumerate() {
+        for ((fb, b), ib) in files.iter().zip(maps).zip(&images).skip(i + 1) {
+            refuse_same_pair((fa, a, ia), (fb, b, ib))?;
             refuse_far_resolutions(fa, a, fb, b)?;
         }
     }
     Ok(())
 }
 
-/// Refuses `a` (read from `fa`) and `b` (from `fb`) when they are one map: one file, one image, or the same cells.
-fn refuse_same_pair(fa: &Path, a: &OccupancyGrid, fb: &Path, b: &OccupancyGrid) -> Result<()> {
+/// Refuses `a` (read from `fa`, naming the image `ia`) and `b` when they are one map: one file, one image, or the
+/// same cells.
+fn refuse_same_pair(
+    (fa, a, ia): (&Path, &OccupancyGrid, &Option<PathBuf>),
+    (fb, b, ib): (&Path, &OccupancyGrid, &Option<PathBuf>),
+) -> Result<()> {
     let same_file = fa.canonicalize().ok().is_some_and(|p| fb.canonicalize().ok() == Some(p));
     if same_file {
         anyhow::bail!("{} and {}: the same map file given twice", fa.display(), fb.display());
     }
-    let image = |f: &Path| super::paths::read_files(f).get(1).and_then(|i| i.canonicalize().ok());
-    if let Some(shared) = image(fa).filter(|i| image(fb).as_ref() == Some(i)) {
+    if let Some(shared) = ia.as_ref().filter(|i| ib.as_ref() == Some(*i)) {
         anyhow::bail!(
             "{} and {} both name the image {}: merging a map with itself measures nothing",
             fa.display(),
@@ -86,7 +92,7 @@ pub fn run(
     for p in &files[maps.len()..] {
         maps.push(super::map::read_yaml_map(p)?);
     }
-    refuse_same_maps(files, &maps.iter().collect::<Vec<_>>())?;
+    refuse_unmergeable_pairs(files, &maps.iter().collect::<Vec<_>>())?;
     let out = merge_many(merger, &maps, mp);
     if let Some(p) = to.report {
         let files = files.iter().map(|f| f.display().to_string()).collect();

@@ -198,8 +198,8 @@ pub fn run(args: SlamArgs) -> Result<ExitCode> {
     args.drift.inject(&mut odo, args.seed);
     // Jumps as the log's lines have them, before the re-timing below blends each scan's with the next's.
     let jumps = odometry_jumps(&odo, &log.scans);
-    let scans: Vec<&LaserScan> = log.scans.iter().map(|r| &r.scan).collect();
     let lag = if log.odometry.is_empty() {
+        let scans: Vec<&LaserScan> = log.scans.iter().map(|r| &r.scan).collect();
         odometry_lag::retime_line_odometry(&mut odo, &scans, &params, log.scans[0].laser_offset)
     } else {
         None

@@ -267,8 +267,8 @@ impl Default for AnswerParams {
 pub struct CorrelativeMerger {
     /// Its parameters.
     pub params: CorrelativeParams,
-    /// The robots' contact, when the maps come from robots in contact: the searches keep to the translations
-    /// that put them within reach ([`crate::Merger::align_near`]).
+    /// The robots' contact, when the maps come from robots in contact ([`crate::Merger::align_near`]): with
+    /// [`crate::Contact::search_within`], the searches keep to the translations that put them within reach.
     pub contact: Option<Contact>,
 }
 
