@@ -340,10 +340,11 @@ pub fn run(args: SlamArgs) -> Result<ExitCode> {
     println!("log: {} ({:.1} s); {}", args.log.display(), duration, log.repairs.describe());
     println!("odometry: {}", log.repairs.describe_odometry());
     if let Some(l) = &lag {
-        let verdict = match (l.applies(), l.lag_s > 0.0) {
-            (true, true) => format!("the scan lines' odometry is {:.3} s late; re-timed", l.lag_s),
-            (true, false) => format!("the scan lines' odometry is {:.3} s early; re-timed", -l.lag_s),
-            (false, _) => "none worth re-timing the scan lines' odometry by".to_string(),
+        let verdict = match (l.given_s, l.applies(), l.lag_s > 0.0) {
+            (Some(g), _, _) => format!("re-timed by the {g:+.3} s given (scan_odometry_line_lag_s)"),
+            (None, true, true) => format!("the scan lines' odometry is {:.3} s late; re-timed", l.lag_s),
+            (None, true, false) => format!("the scan lines' odometry is {:.3} s early; re-timed", -l.lag_s),
+            (None, false, _) => "none worth re-timing the scan lines' odometry by".to_string(),
         };
         println!(
             "odometry lag: {verdict} (the best lag, {:+.3} s, leaves {:.0} % of the squared heading misfit of {} \
@@ -454,7 +455,8 @@ pub fn run(args: SlamArgs) -> Result<ExitCode> {
             },
             "odometry_jumps": jumps.len(),
             "line_odometry_lag": lag.map(|l| json!({
-                "lag_s": l.lag_s, "pairs": l.pairs, "residual_ratio": l.residual_ratio, "applied": l.applies()
+                "lag_s": l.lag_s, "pairs": l.pairs, "residual_ratio": l.residual_ratio, "applied": l.applies(),
+                "given_s": l.given_s, "used_s": l.used_s()
             })),
             "scan_odometry": filter.params().scan_odometry.enabled.then(|| {
                 let (matched, turned_round, dead) = filter.scan_odometry_counts();

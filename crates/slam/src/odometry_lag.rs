@@ -36,6 +36,9 @@ pub const PRIOR_LOOSENING: f64 = 10.0;
 pub struct LagEstimate {
     /// The lag that explains the scans' heading changes best, seconds (positive: the odometry is late).
     pub lag_s: f64,
+    /// The lag the odometry was re-timed by instead, seconds, when one was given
+    /// ([`crate::ScanOdometryParams::line_lag_s`]).
+    pub given_s: Option<f64>,
     /// Scan pairs whose matched heading change was compared.
     pub pairs: usize,
     /// Sum of squared heading residuals at `lag_s` over the same at no lag.
@@ -46,6 +49,11 @@ impl LagEstimate {
     /// Whether the lag is worth re-timing the odometry by: long enough, and clearly better than none.
     pub fn applies(&self) -> bool {
         self.lag_s.abs() >= LAG_MIN_S && self.residual_ratio <= LAG_MIN_GAIN
+    }
+
+    /// The lag the odometry is re-timed by: the one given, else the estimate when it applies, else 0.
+    pub fn used_s(&self) -> f64 {
+        self.given_s.unwrap_or(if self.applies() { self.lag_s } else { 0.0 })
     }
 }
 
@@ -105,12 +113,12 @@ pub fn estimate_lag(
         .map(|i| f64::from(i) * LAG_STEP)
         .map(|lag| (lag, residual(lag)))
         .min_by(|a, b| a.1.total_cmp(&b.1).then(a.0.abs().total_cmp(&b.0.abs())))?;
-    Some(LagEstimate { lag_s, pairs, residual_ratio: best / none })
+    Some(LagEstimate { lag_s, given_s: None, pairs, residual_ratio: best / none })
 }
 
 /// Re-times per-scan odometry by its lag when `params` ask for it (scan odometry with
-/// [`crate::ScanOdometryParams::line_lag`]) and the lag [`applies`](LagEstimate::applies); the estimate, applied
-/// or not. For logs without an odometry stream only: a stream is interpolated at the scans' own stamps.
+/// [`crate::ScanOdometryParams::line_lag`]): by the lag given in `line_lag_s`, else by the estimate when it
+/// [`applies`](LagEstimate::applies); the estimate, applied or not. For logs without an odometry stream only: a stream is interpolated at the scans' own stamps.
 pub fn retime_line_odometry(
     odometry: &mut [Odometry],
     scans: &[&LaserScan],
@@ -120,9 +128,11 @@ pub fn retime_line_odometry(
     if !(params.scan_odometry.enabled && params.scan_odometry.line_lag) {
         return None;
     }
-    let estimate = estimate_lag(odometry, scans, params, laser)?;
-    if estimate.applies() {
-        retime(odometry, estimate.lag_s);
+    let mut estimate = estimate_lag(odometry, scans, params, laser)?;
+    let given = params.scan_odometry.line_lag_s;
+    estimate.given_s = (given != 0.0).then_some(given);
+    if estimate.used_s() != 0.0 {
+        retime(odometry, estimate.used_s());
     }
     Some(estimate)
 }
@@ -190,6 +200,28 @@ mod tests {
         assert!((Xyt::from_pose(&odo[1].pose).theta - 0.125).abs() < 1e-12);
         let stamps: Vec<f64> = odo.iter().map(|o| o.stamp).collect();
         assert_eq!(stamps, [0.0, 0.2, 0.4, 0.6000000000000001, 0.8], "stamps stay the scans'");
+    }
+
+    #[test]
+    fn a_lag_given_is_used_instead_of_the_estimate_and_a_lag_beyond_a_second_is_refused() {
+        let path: Vec<Pose2> =
+            synthetic::waypoint_path(&synthetic::office_loop(), 0.05, 0.05).into_iter().take(200).collect();
+        let laser = pose(0.1, 0.0, 0.0);
+        let run = synthetic::simulate(&synthetic::office_map(), &path, 0.1, &Lidar::sick(), laser, &Drift::none(), 3);
+        let scans: Vec<&LaserScan> = run.scans.iter().collect();
+        let mut params = SlamParams::default();
+        params.set("scan_odometry", "true").unwrap();
+        params.set("scan_odometry_line_lag_s", "0.1").unwrap();
+        let mut odo = run.odometry.clone();
+        let lag = retime_line_odometry(&mut odo, &scans, &params, laser).expect("an estimate");
+        assert_eq!((lag.given_s, lag.used_s()), (Some(0.1), 0.1), "{lag:?}");
+        assert!(!lag.applies(), "on-time odometry: the estimate alone would not re-time it: {lag:?}");
+        let mut expected = run.odometry.clone();
+        retime(&mut expected, 0.1);
+        assert_eq!(odo, expected);
+        params.set("scan_odometry_line_lag_s", "2").unwrap();
+        let err = params.validate().unwrap_err().to_string();
+        assert!(err.contains("scan_odometry.line_lag_s") && err.contains("within ±1 s"), "{err}");
     }
 
     #[test]

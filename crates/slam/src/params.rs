@@ -158,6 +158,7 @@ pub const FLAT_NAMES: &[(&str, &str)] = &[
     ("scan_odometry_reach", "scan_odometry.reach"),
     ("scan_odometry_turn_round", "scan_odometry.turn_round"),
     ("scan_odometry_line_lag", "scan_odometry.line_lag"),
+    ("scan_odometry_line_lag_s", "scan_odometry.line_lag_s"),
     ("loop_closure", "loop_closure.enabled"),
     ("loop_min_travel", "loop_closure.min_travel"),
     ("loop_search_radius", "loop_closure.search_radius"),
@@ -381,6 +382,9 @@ impl SlamParams {
         pos("scan_odometry.range", so.range)?;
         pos("scan_odometry.sigma", so.sigma)?;
         nonneg("scan_odometry.heading_search", so.heading_search)?;
+        if !(so.line_lag_s.abs() <= 1.0) {
+            return invalid("scan_odometry.line_lag_s", format!("must be within ±1 s, got {}", so.line_lag_s));
+        }
         if so.heading_search / 0.01 > 1000.0 {
             return invalid("scan_odometry.heading_search", "must be at most 10 rad".into());
         }

@@ -83,6 +83,10 @@ pub struct ScanOdometryParams {
     /// behind the scans estimated from the scans' matched heading changes and is re-timed by it
     /// ([`crate::odometry_lag`]): a logger that wrote the last reading it had is a fraction of a scan period late.
     pub line_lag: bool,
+    /// `scan_odometry_line_lag_s`, seconds: re-time the scan lines' odometry by this lag instead of the
+    /// estimated one (positive: the odometry is late), when `line_lag` is on; 0 (the default): estimate it.
+    /// For a user who knows the lag, and to measure how a map depends on it.
+    pub line_lag_s: f64,
 }
 
 impl Default for ScanOdometryParams {
@@ -96,6 +100,7 @@ impl Default for ScanOdometryParams {
             reach: 3,
             turn_round: true,
             line_lag: true,
+            line_lag_s: 0.0,
         }
     }
 }
