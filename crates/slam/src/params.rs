@@ -382,7 +382,7 @@ impl SlamParams {
         pos("scan_odometry.range", so.range)?;
         pos("scan_odometry.sigma", so.sigma)?;
         nonneg("scan_odometry.heading_search", so.heading_search)?;
-        if !(so.line_lag_s.abs() <= 1.0) {
+        if so.line_lag_s.is_nan() || so.line_lag_s.abs() > 1.0 {
             return invalid("scan_odometry.line_lag_s", format!("must be within ±1 s, got {}", so.line_lag_s));
         }
         if so.heading_search / 0.01 > 1000.0 {
