@@ -6,12 +6,13 @@ use super::outputs::{Outputs, kind};
 use super::run_bag::RunBag;
 use anyhow::{Context, Result, bail};
 use clap::Args;
-use mrslam_core::Odometry;
 use mrslam_core::output::{AtomicFile, write_file_atomic};
 use mrslam_core::relations::{StampedPose, format_relations, format_trajectory};
 use mrslam_core::truth_relations::{TruthRelations, relations_from_truth};
+use mrslam_core::{LaserScan, Odometry};
 use mrslam_log::carmen_writer::CarmenWriter;
-use mrslam_testbed::runner::{PoseHistory, RobotStep, RunOptions, run as run_scenario};
+use mrslam_sim::LidarModel;
+use mrslam_testbed::runner::{PoseHistory, RobotStep, RunOptions, pairing_time, run as run_scenario};
 use mrslam_testbed::scenario::Scenario;
 use serde_json::json;
 use std::path::{Path, PathBuf};
@@ -57,6 +58,8 @@ struct RobotLog {
     range_max: f32,
     /// The robot's recent true and odometry poses.
     history: PoseHistory,
+    /// The robot's lidar, for the instant each scan is paired with ([`pairing_time`]).
+    lidar: LidarModel,
 }
 
 /// The files `mrslam sim log` writes for robot `name` in `dir`.
@@ -115,6 +118,7 @@ pub fn run(args: LogArgs) -> Result<ExitCode> {
             beams: 0,
             range_max: 0.0,
             history: PoseHistory::default(),
+            lidar: r.lidar.clone(),
         });
     }
     // Ctrl-C (or SIGTERM, SIGHUP): the logs and the bag being written are hidden temporary files; they go.
@@ -129,16 +133,21 @@ pub fn run(args: LogArgs) -> Result<ExitCode> {
     let mut write_error: Option<anyhow::Error> = None;
     let odom_lines = !args.no_odom_lines;
     let tap = |s: &RobotStep<'_>| {
+        let log = &mut logs[s.robot];
+        log.history.push(s.time, *s.true_pose, s.odometry.pose);
+        // A scan was taken from its stamp on, up to a scan period before this step's end; a sweeping lidar's is
+        // stamped at its middle beam (a log line has no time per beam, and the bag says none), as the testbed's
+        // runs pair it: in the log and the bag alike, so both map as the truth is drawn.
+        let restamped: Vec<LaserScan> =
+            s.scans.iter().map(|&scan| LaserScan { stamp: pairing_time(&log.lidar, scan), ..scan.clone() }).collect();
+        let scans: Vec<&LaserScan> = restamped.iter().collect();
         if let Some(b) = bag.as_mut() {
-            b.step(s);
+            b.step(&RobotStep { scans: &scans, ..*s });
         }
         if write_error.is_some() {
             return;
         }
-        let log = &mut logs[s.robot];
-        log.history.push(s.time, *s.true_pose, s.odometry.pose);
-        for scan in s.scans {
-            // The scan was taken from its stamp on, up to a scan period before this step's end.
+        for scan in &restamped {
             let (true_pose, odometry_pose) = log.history.at(scan.stamp).unwrap_or((*s.true_pose, s.odometry.pose));
             let odometry = Odometry { stamp: scan.stamp, pose: odometry_pose };
             let written = (|| {

@@ -92,9 +92,10 @@ fn a_simulated_run_is_written_as_a_log_its_truth_and_relations_and_scores_as_the
         eprintln!("{name}: {error:.4} m, {rotation:.3} deg");
         // The truth is the pose at each scan's stamp, its first beam (not when the scan came in, a scan period
         // later: that pairing cost 1-2.5 deg on FR079's generated logs). The RPLidar's beams span its whole
-        // 0.18 s turn and the SLAM does not deskew: turning, its scans sit half a turn's motion off the stamp
-        // (measured 0.008 m / 0.14 deg for the Hokuyo, 0.020 m / 1.45 deg for the RPLidar, seed 3).
-        let bound = if *name == "prawn" { 2.0 } else { 0.5 };
+        // 0.18 s turn and the SLAM does not deskew: its scans are stamped, and paired with truth and odometry, at
+        // the middle beam (at the first, turning scans sat half a turn's motion off: 0.020 m / 1.45 deg, seed 3;
+        // now 0.018 m / 0.49 deg; the Hokuyo 0.008 m / 0.14 deg).
+        let bound = if *name == "prawn" { 0.8 } else { 0.5 };
         assert!(error < 0.03 && rotation < bound, "{name}: SLAM {error} m, {rotation} deg on its own simulated log");
     }
 }

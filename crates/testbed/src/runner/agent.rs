@@ -2,12 +2,12 @@
 //! evaluation needs of its drive.
 
 use super::options::RunError;
-use super::pose_history::PoseHistory;
+use super::pose_history::{PoseHistory, pairing_time};
 use crate::controller::{Controller, Explorer, PurePursuit, blocked_ahead};
 use crate::frontier::Clearance;
 use crate::scenario::{ControllerKind, RobotSetup, Scenario};
 use mrslam_core::{CellTraversal, LaserScan, OccupancyGrid, Odometry, Pose2};
-use mrslam_sim::{LidarModel, RobotId, Sim};
+use mrslam_sim::{RobotId, Sim};
 use mrslam_slam::{Rbpf, SlamBackend};
 use nalgebra::Point2;
 use std::sync::Mutex;
@@ -163,17 +163,6 @@ impl Agent<'_> {
             self.last_scan = Some(scan);
         }
         Ok(())
-    }
-}
-
-/// The instant a scan's odometry is looked up at: its stamp (its first beam) for a scanner that sweeps too fast
-/// to skew (SICK, Hokuyo); for one that sweeps while the robot moves (RPLidar), the middle beam's time, which
-/// halves the worst beam's skew.
-pub(super) fn pairing_time(lidar: &LidarModel, scan: &LaserScan) -> f64 {
-    if lidar.skew {
-        scan.stamp + 0.5 * scan.len().saturating_sub(1) as f64 * lidar.time_increment()
-    } else {
-        scan.stamp
     }
 }
 

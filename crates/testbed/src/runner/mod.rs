@@ -19,7 +19,7 @@ mod team;
 
 pub use options::{RobotStep, RunError, RunOptions, RunOutput, StepTap};
 pub use outputs::{merge_overlay, output_files, write_outputs};
-pub use pose_history::PoseHistory;
+pub use pose_history::{PoseHistory, pairing_time};
 pub use record::merge_view;
 
 use crate::report::RunReport;

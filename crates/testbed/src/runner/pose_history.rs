@@ -4,8 +4,9 @@
 //! now was taken 0.2 s ago. A real robot's SLAM looks its odometry up at the scan's stamp (ROS's tf lookup at
 //! `header.stamp`), and so do the testbed's runs and `mrslam sim log`.
 
-use mrslam_core::Pose2;
 use mrslam_core::pose::interpolate;
+use mrslam_core::{LaserScan, Pose2};
+use mrslam_sim::LidarModel;
 use std::collections::VecDeque;
 
 /// (time, true pose, odometry pose) at the ends of a robot's last steps, oldest first.
@@ -43,6 +44,17 @@ impl PoseHistory {
         };
         let s = if b.0 > a.0 { ((time - a.0) / (b.0 - a.0)).clamp(0.0, 1.0) } else { 0.0 };
         Some((interpolate(&a.1, &b.1, s), interpolate(&a.2, &b.2, s)))
+    }
+}
+
+/// The instant a scan's odometry and truth are looked up at: its stamp (its first beam) for a scanner that sweeps
+/// too fast to skew (SICK, Hokuyo); for one that sweeps while the robot moves (RPLidar), the middle beam's time,
+/// which halves the worst beam's skew.
+pub fn pairing_time(lidar: &LidarModel, scan: &LaserScan) -> f64 {
+    if lidar.skew {
+        scan.stamp + 0.5 * scan.len().saturating_sub(1) as f64 * lidar.time_increment()
+    } else {
+        scan.stamp
     }
 }
 
