@@ -19,13 +19,18 @@ impl Field {
         let mut pts = [(0.0f64, 0.0f64, 0.0f64); MAX];
         let mut ids = [0u32; MAX];
         let mut n = 0;
-        let own = self.occ[(oy * pw + ox) as usize];
+        let words = self.geometry.words;
+        // `occ` holds this build's indices only where `occ_bits` marks an occupied cell
+        let occupied_at = |x: i32, y: i32| {
+            let (x, y) = (x as usize, y as usize);
+            (self.occ_bits[y * words + x / 64] >> (x % 64) & 1 != 0).then(|| self.occ[y * pw as usize + x])
+        };
+        let own = occupied_at(ox, oy).unwrap_or(0);
         for y in (oy - radius).max(0)..=(oy + radius).min(ph - 1) {
             for x in (ox - radius).max(0)..=(ox + radius).min(pw - 1) {
-                let k = self.occ[(y * pw + x) as usize];
-                if k == 0 || n == MAX {
+                let Some(k) = occupied_at(x, y).filter(|_| n < MAX) else {
                     continue;
-                }
+                };
                 let (_, _, mx, my, hits, _) = self.occupied[k as usize - 1];
                 let p = (mx as f64, my as f64, hits.min(LINE_WEIGHT_CAP) as f64);
                 if k == own {
