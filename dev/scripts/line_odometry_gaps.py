@@ -6,40 +6,17 @@ line_odometry_vs_odom.py). A line written stale (a logger's last reading from be
 
     python3 dev/scripts/line_odometry_gaps.py ../shared/data/logs/aces.clf.gz [LAG]      (LAG: 0.12 s by default)
 """
-import bisect
-import gzip
 import math
+import os
 import sys
 
-
-def wrap(a):
-    return (a + math.pi) % (2 * math.pi) - math.pi
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from line_odometry_vs_odom import interpolator, read, wrap  # noqa: E402
 
 
 def main(path, lag):
-    odom, lines = [], []
-    with gzip.open(path, "rt") if path.endswith(".gz") else open(path) as f:
-        for line in f:
-            p = line.split()
-            if not p:
-                continue
-            if p[0] == "ODOM":
-                odom.append((float(p[7]), float(p[1]), float(p[2]), float(p[3])))
-            elif p[0] == "FLASER":
-                n = int(p[1])
-                v = p[2 + n:]
-                lines.append((float(v[6]), float(v[3]), float(v[4]), float(v[5])))
-    odom.sort()
-    stamps = [o[0] for o in odom]
-
-    def at(t):
-        i = bisect.bisect_right(stamps, t)
-        if i == 0 or i == len(stamps):
-            return None
-        a, b = odom[i - 1], odom[i]
-        f = (t - a[0]) / (b[0] - a[0]) if b[0] > a[0] else 0.0
-        return a[1] + f * (b[1] - a[1]), a[2] + f * (b[2] - a[2]), a[3] + f * wrap(b[3] - a[3])
-
+    odom, lines = read(path)
+    at = interpolator(odom)
     gaps = sorted(lines[i + 1][0] - lines[i][0] for i in range(len(lines) - 1))
     period = gaps[len(gaps) // 2]
     print(f"{path}: {len(odom)} ODOM lines, {len(lines)} FLASER lines, median scan period {period:.3f} s")
