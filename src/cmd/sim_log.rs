@@ -33,6 +33,11 @@ pub struct LogArgs {
     /// Write no ODOM lines: the odometry is only in the scan lines, as in some benchmark logs.
     #[arg(long)]
     pub no_odom_lines: bool,
+    /// Write each scan line's odometry fields as the odometry of this many seconds before the scan, as a logger
+    /// that writes the last reading it had (0 to 1 s; the ODOM lines stay on time): a log to measure
+    /// `slam`'s lag estimate on.
+    #[arg(long, default_value_t = 0.0, value_name = "SECONDS")]
+    pub line_odometry_lag: f64,
     /// Loop relations join poses at most this far apart, metres (local ones every metre of driving).
     #[arg(long, default_value_t = TruthRelations::default().loop_radius)]
     pub loop_radius: f64,
@@ -76,6 +81,9 @@ pub fn run(args: LogArgs) -> Result<ExitCode> {
     }
     if !(truth_params.loop_min_travel >= 0.0 && truth_params.loop_min_travel.is_finite()) {
         bail!("--loop-min-travel {}: must be a number of metres, 0 or more", args.loop_min_travel);
+    }
+    if !(0.0..=1.0).contains(&args.line_odometry_lag) {
+        bail!("--line-odometry-lag {}: must be a number of seconds from 0 to 1", args.line_odometry_lag);
     }
     let mut scenario = Scenario::from_file(&args.scenario)?;
     if let Some(s) = args.seed {
@@ -132,6 +140,7 @@ pub fn run(args: LogArgs) -> Result<ExitCode> {
     let bar = super::sim_progress::bar(&scenario.name, scenario.duration, args.quiet);
     let mut write_error: Option<anyhow::Error> = None;
     let odom_lines = !args.no_odom_lines;
+    let line_lag = args.line_odometry_lag;
     let tap = |s: &RobotStep<'_>| {
         let log = &mut logs[s.robot];
         log.history.push(s.time, *s.true_pose, s.odometry.pose);
@@ -150,11 +159,13 @@ pub fn run(args: LogArgs) -> Result<ExitCode> {
         for scan in &restamped {
             let (true_pose, odometry_pose) = log.history.at(scan.stamp).unwrap_or((*s.true_pose, s.odometry.pose));
             let odometry = Odometry { stamp: scan.stamp, pose: odometry_pose };
+            let late = (line_lag > 0.0).then(|| log.history.at(scan.stamp - line_lag)).flatten();
+            let line_odometry = late.map_or(odometry, |(_, pose)| Odometry { pose, ..odometry });
             let written = (|| {
                 if odom_lines {
                     log.writer.odometry(&odometry)?;
                 }
-                log.writer.scan(scan, &odometry, s.mount)
+                log.writer.scan(scan, &line_odometry, s.mount)
             })();
             if let Err(e) = written {
                 write_error = Some(anyhow::anyhow!("{}.clf: {e}", log.name));
@@ -227,6 +238,7 @@ pub fn run(args: LogArgs) -> Result<ExitCode> {
             "loop_relations": drawn.loops.len(),
             "longest_loop_m": longest,
             "odom_lines": odom_lines,
+            "line_odometry_lag_s": line_lag,
         }));
     }
     let summary = json!({
