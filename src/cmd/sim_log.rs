@@ -15,6 +15,7 @@ use mrslam_sim::LidarModel;
 use mrslam_testbed::runner::{PoseHistory, RobotStep, RunOptions, pairing_time, run as run_scenario};
 use mrslam_testbed::scenario::Scenario;
 use serde_json::json;
+use std::borrow::Cow;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -147,16 +148,22 @@ pub fn run(args: LogArgs) -> Result<ExitCode> {
         // A scan was taken from its stamp on, up to a scan period before this step's end; a sweeping lidar's is
         // stamped at its middle beam (a log line has no time per beam, and the bag says none), as the testbed's
         // runs pair it: in the log and the bag alike, so both map as the truth is drawn.
-        let restamped: Vec<LaserScan> =
-            s.scans.iter().map(|&scan| LaserScan { stamp: pairing_time(&log.lidar, scan), ..scan.clone() }).collect();
-        let scans: Vec<&LaserScan> = restamped.iter().collect();
+        let restamped: Vec<Cow<'_, LaserScan>> = s
+            .scans
+            .iter()
+            .map(|&scan| match pairing_time(&log.lidar, scan) {
+                t if t == scan.stamp => Cow::Borrowed(scan),
+                t => Cow::Owned(LaserScan { stamp: t, ..scan.clone() }),
+            })
+            .collect();
+        let scans: Vec<&LaserScan> = restamped.iter().map(|scan| scan.as_ref()).collect();
         if let Some(b) = bag.as_mut() {
             b.step(&RobotStep { scans: &scans, ..*s });
         }
         if write_error.is_some() {
             return;
         }
-        for scan in &restamped {
+        for &scan in &scans {
             let (true_pose, odometry_pose) = log.history.at(scan.stamp).unwrap_or((*s.true_pose, s.odometry.pose));
             let odometry = Odometry { stamp: scan.stamp, pose: odometry_pose };
             let late = (line_lag > 0.0).then(|| log.history.at(scan.stamp - line_lag)).flatten();

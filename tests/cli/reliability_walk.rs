@@ -12,6 +12,13 @@ fn yaml_like(dir: &Path, name: &str, image: &str, resolution: &str, origin: &str
     path
 }
 
+/// An empty file `x.clf` in `dir`: for checks made before the log is read.
+fn empty_log(dir: &Path) -> std::path::PathBuf {
+    let log = dir.join("x.clf");
+    std::fs::write(&log, "").unwrap();
+    log
+}
+
 #[test]
 fn maps_of_absurd_or_far_apart_resolutions_are_refused_before_any_work() {
     let dir = tempfile::tempdir().unwrap();
@@ -49,8 +56,7 @@ fn slam_refuses_a_map_resolution_no_reader_would_read() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     // The parameters are checked before the log is read, so any file does.
-    let log = d.join("x.clf");
-    std::fs::write(&log, "").unwrap();
+    let log = empty_log(d);
     for delta in ["1e300", "150"] {
         let o = fails_with(
             &["slam", p(&log), "-o", p(&d.join("s.yaml")), "--set", &format!("delta={delta}")],
@@ -218,8 +224,7 @@ fn an_output_name_that_is_not_utf8_is_refused_before_any_work() {
     use std::os::unix::ffi::OsStrExt;
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    let log = d.join("x.clf");
-    std::fs::write(&log, "").unwrap();
+    let log = empty_log(d);
     let out = d.join(std::ffi::OsStr::from_bytes(b"y\xff.yaml"));
     let o = std::process::Command::new(env!("CARGO_BIN_EXE_mrslam"))
         .arg("slam")

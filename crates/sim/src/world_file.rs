@@ -334,6 +334,7 @@ impl WorldSpec {
         // Finite and within the bound: a coordinate or a size further out is a typo, and would overflow the grids
         // the simulator builds over the world.
         let finite = |v: &[f64]| v.iter().all(|x| x.is_finite() && x.abs() <= MAX_WORLD_COORDINATE);
+        let far = |what: &str| format!("{what} must be finite and within {MAX_WORLD_COORDINATE:e} m of 0");
         for (i, w) in self.walls.iter().enumerate() {
             let s = spans.walls.get(i);
             if w.points.len() < 2 {
@@ -346,13 +347,7 @@ impl WorldSpec {
                 ));
             }
             if !w.points.iter().all(|p| finite(p)) {
-                return Err(err(
-                    "walls",
-                    Some(i),
-                    s,
-                    "points",
-                    format!("coordinates must be finite and within {MAX_WORLD_COORDINATE:e} m of 0"),
-                ));
+                return Err(err("walls", Some(i), s, "points", far("coordinates")));
             }
             if let Some(k) = w.points.windows(2).position(|p| p[0] == p[1]) {
                 return Err(err(
@@ -376,13 +371,7 @@ impl WorldSpec {
         for (i, b) in self.boxes.iter().enumerate() {
             let s = spans.boxes.get(i);
             if !finite(&b.center) {
-                return Err(err(
-                    "boxes",
-                    Some(i),
-                    s,
-                    "center",
-                    format!("must be within {MAX_WORLD_COORDINATE:e} m of 0"),
-                ));
+                return Err(err("boxes", Some(i), s, "center", far("the centre")));
             }
             if !(finite(&b.size) && b.size[0] > 0.0 && b.size[1] > 0.0) {
                 return Err(err(
@@ -404,13 +393,7 @@ impl WorldSpec {
         for (i, c) in self.circles.iter().enumerate() {
             let s = spans.circles.get(i);
             if !finite(&c.center) {
-                return Err(err(
-                    "circles",
-                    Some(i),
-                    s,
-                    "center",
-                    format!("must be within {MAX_WORLD_COORDINATE:e} m of 0"),
-                ));
+                return Err(err("circles", Some(i), s, "center", far("the centre")));
             }
             if !(finite(&[c.radius]) && c.radius > 0.0) {
                 return Err(err(
@@ -434,13 +417,7 @@ impl WorldSpec {
                 ));
             }
             if !p.points.iter().all(|q| finite(q)) {
-                return Err(err(
-                    "polygons",
-                    Some(i),
-                    s,
-                    "points",
-                    format!("coordinates must be finite and within {MAX_WORLD_COORDINATE:e} m of 0"),
-                ));
+                return Err(err("polygons", Some(i), s, "points", far("coordinates")));
             }
             let pts = to_points(&p.points);
             if signed_area(&pts).abs() < 1e-9 {
@@ -453,8 +430,7 @@ impl WorldSpec {
         for (name, p) in &self.named_points {
             let s = spans.named_points.get(name);
             if !finite(&[p.x, p.y, p.theta]) {
-                let message = format!("x, y and theta must be finite and within {MAX_WORLD_COORDINATE:e} m of 0");
-                return Err(err("named_points", None, s, name, message));
+                return Err(err("named_points", None, s, name, far("x, y and theta")));
             }
         }
         Ok(())

@@ -118,7 +118,8 @@ pub fn estimate_lag(
 
 /// Re-times per-scan odometry by its lag when `params` ask for it (scan odometry with
 /// [`crate::ScanOdometryParams::line_lag`]): by the lag given in `line_lag_s`, else by the estimate when it
-/// [`applies`](LagEstimate::applies); the estimate, applied or not. For logs without an odometry stream only: a stream is interpolated at the scans' own stamps.
+/// [`applies`](LagEstimate::applies); the estimate, applied or not (reported beside a lag given). For logs
+/// without an odometry stream only: a stream is interpolated at the scans' own stamps.
 pub fn retime_line_odometry(
     odometry: &mut [Odometry],
     scans: &[&LaserScan],
