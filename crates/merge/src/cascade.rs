@@ -9,6 +9,8 @@
 //! ```
 //!
 //! The first answer the gate accepts is the merge; a pair every stage refuses is refused with each stage's reason.
+//! `sift+boundary` runs on another thread beside `sift` (the answer of `sift` still comes first), so a pair both
+//! refuse costs one SIFT stage's wall time.
 //! Each stage is a second chance for a wrong pose too, so the order and the stages were chosen by measuring false
 //! merges on non-overlapping pairs alongside the successes (benchmarks/runs/2026-12-02-merge-cascade.md).
 
@@ -36,6 +38,9 @@ pub struct Stage {
     /// they are, and `Always` already gave the first stage those walls. With `Always`, it is also skipped when
     /// neither map marks its walls: the first stage saw the same walls.
     pub boundary_walls: Option<BoundaryWalls>,
+    /// Run on another thread at the same time as the stage before it, whose answer still comes first: for a stage
+    /// about as cheap as that one (`sift+boundary` beside `sift`), so a pair both refuse costs one stage's wall time.
+    pub beside_previous: bool,
 }
 
 /// Mergers tried in turn through the gate; the first accepted answer is the merge (`--algorithm cascade`).
@@ -49,16 +54,23 @@ impl Cascade {
     pub fn new(sift: SiftMergerParams, correlative: CorrelativeParams) -> Self {
         Cascade {
             stages: vec![
-                Stage { name: "sift", merger: Box::new(SiftMerger::new(sift.clone())), boundary_walls: None },
+                Stage {
+                    name: "sift",
+                    merger: Box::new(SiftMerger::new(sift.clone())),
+                    boundary_walls: None,
+                    beside_previous: false,
+                },
                 Stage {
                     name: "sift+boundary",
                     merger: Box::new(SiftMerger::new(sift)),
                     boundary_walls: Some(BoundaryWalls::Always),
+                    beside_previous: true,
                 },
                 Stage {
                     name: "correlative",
                     merger: Box::new(CorrelativeMerger::new(correlative)),
                     boundary_walls: None,
+                    beside_previous: false,
                 },
             ],
         }
@@ -134,19 +146,36 @@ pub(crate) fn merge_cascade(c: &Cascade, a: &OccupancyGrid, b: &OccupancyGrid, p
     let mut last: Option<MergeOutcome> = None;
     // Each map's boundary found once for every stage (its walls, whether it marks them).
     let (ba, bb) = (Boundary::of(a), Boundary::of(b));
-    for (stage, params) in c.active(p, ba.marks_its_walls() || bb.marks_its_walls()) {
-        let mut out = merge_bounded(stage.merger.as_ref(), (a, b), Some((&ba, &bb)), &params, Instant::now());
-        for (k, v) in std::mem::take(&mut out.report.timings_ms) {
-            timings.insert(format!("{}/{k}", stage.name), v);
-        }
-        timings.insert(stage.name.to_string(), out.report.time_ms);
-        out.report.stage = Some(stage.name.to_string());
-        if out.report.accepted {
+    let run = |(stage, params): &(&Stage, MergeParams)| {
+        merge_bounded(stage.merger.as_ref(), (a, b), Some((&ba, &bb)), params, Instant::now())
+    };
+    let active: Vec<(&Stage, MergeParams)> = c.active(p, ba.marks_its_walls() || bb.marks_its_walls()).collect();
+    let mut next = 0;
+    'stages: while next < active.len() {
+        // A stage and those that run beside it, their outcomes in the cascade's order.
+        let group = 1 + active[next + 1..].iter().take_while(|(s, _)| s.beside_previous).count();
+        let outcomes = match &active[next..next + group] {
+            [one] => vec![run(one)],
+            [first, rest @ ..] => {
+                let (first, rest) = rayon::join(|| run(first), || rest.iter().map(run).collect::<Vec<_>>());
+                std::iter::once(first).chain(rest).collect()
+            }
+            [] => Vec::new(),
+        };
+        for ((stage, _), mut out) in active[next..next + group].iter().zip(outcomes) {
+            for (k, v) in std::mem::take(&mut out.report.timings_ms) {
+                timings.insert(format!("{}/{k}", stage.name), v);
+            }
+            timings.insert(stage.name.to_string(), out.report.time_ms);
+            out.report.stage = Some(stage.name.to_string());
+            if out.report.accepted {
+                last = Some(out);
+                break 'stages;
+            }
+            reasons.push(format!("{}: {}", stage.name, out.report.reason.as_deref().unwrap_or("refused")));
             last = Some(out);
-            break;
         }
-        reasons.push(format!("{}: {}", stage.name, out.report.reason.as_deref().unwrap_or("refused")));
-        last = Some(out);
+        next += group;
     }
     let Some(mut out) = last else {
         return refused(c.name(), NO_STAGES.into(), 0, BTreeMap::new(), start);
@@ -176,6 +205,7 @@ mod tests {
             name,
             merger: Box::new(Fixed(vec![t])),
             boundary_walls,
+            beside_previous: false,
         };
         Cascade { stages: stages.iter().map(stage).collect() }
     }
@@ -199,7 +229,12 @@ mod tests {
         assert!(marks_its_walls(&g) && !marks_its_walls(&bare));
         let off = pose(1.0, 0.0, 0.0);
         let mut c = cascade(&[("first", off, None), ("boundary", off, Some(BoundaryWalls::Always))]);
-        c.stages.push(Stage { name: "marked", merger: Box::new(NeedsWalls(Fixed(vec![off]))), boundary_walls: None });
+        c.stages.push(Stage {
+            name: "marked",
+            merger: Box::new(NeedsWalls(Fixed(vec![off]))),
+            boundary_walls: None,
+            beside_previous: false,
+        });
         let ran = |a: &OccupancyGrid, b: &OccupancyGrid| -> Vec<&str> {
             let reason = crate::merge(&c, a, b, &MergeParams::default()).report.reason.unwrap();
             ["first", "boundary", "marked"].into_iter().filter(|n| reason.contains(&format!("{n}: "))).collect()
@@ -247,6 +282,33 @@ mod tests {
         assert!(out.report.timings_ms.contains_key("first") && out.report.timings_ms.contains_key("second"));
         assert!(out.report.timings_ms.keys().any(|k| k.starts_with("second/")));
         assert!(!out.report.timings_ms.contains_key("third"));
+    }
+
+    #[test]
+    fn a_stage_run_beside_the_one_before_it_decides_only_when_that_one_refuses() {
+        let g = room(true);
+        let off = pose(1.0, 0.0, 0.0);
+        let beside = |stages: &[(&'static str, Pose2)]| {
+            let mut c = cascade(&stages.iter().map(|&(n, t)| (n, t, None)).collect::<Vec<_>>());
+            c.stages[1].beside_previous = true;
+            crate::merge(&c, &g, &g, &MergeParams::default()).report
+        };
+        // Both right: the first's answer, the second's unused (not timed).
+        let r = beside(&[("first", Pose2::identity()), ("second", Pose2::identity()), ("third", off)]);
+        assert_eq!(r.stage.as_deref(), Some("first"));
+        assert!(!r.timings_ms.contains_key("second") && !r.timings_ms.contains_key("third"));
+        // The first refused: the second's, as if run after it; the third never ran.
+        let r = beside(&[("first", off), ("second", Pose2::identity()), ("third", off)]);
+        assert!(r.accepted, "{:?}", r.reason);
+        assert_eq!(r.stage.as_deref(), Some("second"));
+        assert!(r.timings_ms.contains_key("first") && !r.timings_ms.contains_key("third"));
+        // Both refused: the third decides, every reason in order.
+        let r = beside(&[("first", off), ("second", off), ("third", Pose2::identity())]);
+        assert_eq!(r.stage.as_deref(), Some("third"));
+        let r = beside(&[("first", off), ("second", off), ("third", off)]);
+        let reason = r.reason.unwrap();
+        let at = |n: &str| reason.find(&format!("{n}: ")).unwrap();
+        assert!(at("first") < at("second") && at("second") < at("third"), "{reason}");
     }
 
     #[test]

@@ -50,6 +50,7 @@ mod calibration;
 mod error;
 mod every_scan;
 mod field;
+mod incremental_map;
 mod loop_closure;
 mod loop_graph;
 mod map_build;

@@ -75,13 +75,23 @@ fn sensor(p: &Xyt, laser: &Xyt) -> Xyt {
     Xyt { x: p.x + c * laser.x - s * laser.y, y: p.y + s * laser.x + c * laser.y, theta: p.theta + laser.theta }
 }
 
-/// Builds the map of a trajectory (nodes in any order; order does not change the counts).
+/// The cells a map of some nodes spans, and the counts its cells hold.
 ///
-/// Returns a 1×1 unknown grid when there is nothing to map, and `None` when the map would exceed
-/// core's cell limit.
-pub fn build_map(nodes: &[&TrajectoryNode], laser: &Xyt, params: &MapParams) -> Option<OccupancyGrid> {
+/// `hits`: with `wall_hits`, the beams that ended in each cell (pass 2, before any trace); else the traced beams
+/// that ended there. `visits`: the traced beams that crossed or ended in each cell.
+#[derive(Debug, Clone)]
+pub(crate) struct Counts {
+    pub x0: i64,
+    pub y0: i64,
+    pub w: usize,
+    pub h: usize,
+    pub hits: Vec<u32>,
+    pub visits: Vec<u32>,
+}
+
+/// The cell bounds (x0, y0, x1, y1) of the sensor poses and beam ends of `nodes`; `None` for nothing to map.
+pub(crate) fn cell_bounds(nodes: &[&TrajectoryNode], laser: &Xyt, params: &MapParams) -> Option<(i64, i64, i64, i64)> {
     let inv = 1.0 / params.delta;
-    // Pass 1: bounds in cells.
     let (mut x0, mut y0, mut x1, mut y1) = (i64::MAX, i64::MAX, i64::MIN, i64::MIN);
     let mut grow = |x: f64, y: f64| {
         let (cx, cy) = ((x * inv).floor() as i64, (y * inv).floor() as i64);
@@ -100,92 +110,170 @@ pub fn build_map(nodes: &[&TrajectoryNode], laser: &Xyt, params: &MapParams) -> 
             }
         }
     }
-    if x0 > x1 {
-        return OccupancyGrid::new(1, 1, params.delta, pose(0.0, 0.0, 0.0)).ok();
+    (x0 <= x1).then_some((x0, y0, x1, y1))
+}
+
+/// A node's sensor in the grid's cell coordinates (x, y) and its heading.
+pub(crate) fn sensor_in_cells(n: &TrajectoryNode, laser: &Xyt, params: &MapParams, c: &Counts) -> (f64, f64, f64) {
+    let inv = 1.0 / params.delta;
+    let lp = sensor(&n.pose, laser);
+    (lp.x * inv - c.x0 as f64, lp.y * inv - c.y0 as f64, lp.theta)
+}
+
+/// Beam `i` of `n` as the cells it crosses from the sensor (`at`: [`sensor_in_cells`]), and whether it ends in a
+/// hit; `None` for a beam that maps nothing.
+pub(crate) fn beam_cells(
+    n: &TrajectoryNode,
+    i: usize,
+    at: (f64, f64, f64),
+    params: &MapParams,
+) -> Option<(CellTraversal, bool)> {
+    let inv = 1.0 / params.delta;
+    let (sx, sy, theta) = at;
+    let (r, hit) = beam_end(&n.scan, i, params)?;
+    let a = theta + n.scan.angle(i);
+    let (ex, ey) = (sx + r * a.cos() * inv, sy + r * a.sin() * inv);
+    Some((CellTraversal::new(sx, sy, ex, ey), hit))
+}
+
+impl Counts {
+    /// Zero counts over the cells `x0..=x1`, `y0..=y1`; `None` beyond core's cell limit.
+    pub(crate) fn zeros((x0, y0, x1, y1): (i64, i64, i64, i64)) -> Option<Counts> {
+        let (w, h) = ((x1 - x0 + 1) as usize, (y1 - y0 + 1) as usize);
+        if w.checked_mul(h).is_none_or(|c| c > MAX_CELLS) {
+            return None;
+        }
+        Some(Counts { x0, y0, w, h, hits: vec![0; w * h], visits: vec![0; w * h] })
     }
-    let (w, h) = ((x1 - x0 + 1) as usize, (y1 - y0 + 1) as usize);
-    if w.checked_mul(h).is_none_or(|c| c > MAX_CELLS) {
-        return None;
+
+    /// The index of cell (cx, cy), when it is in the grid.
+    #[inline]
+    pub(crate) fn index(&self, cx: i64, cy: i64) -> Option<usize> {
+        (cx >= 0 && cy >= 0 && (cx as usize) < self.w && (cy as usize) < self.h)
+            .then(|| cy as usize * self.w + cx as usize)
     }
-    let mut hits = vec![0u32; w * h];
-    // Pass 2 (with `wall_hits`): the hits alone, so that pass 3 knows the walls before it traces.
-    let wall = params.wall_hits;
-    if wall > 0 {
+
+    /// Pass 2 (with `wall_hits`): the hits of `nodes` added, so that the traces know the walls before they run.
+    pub(crate) fn add_hits(&mut self, nodes: &[&TrajectoryNode], laser: &Xyt, params: &MapParams) {
+        let inv = 1.0 / params.delta;
         for n in nodes {
-            let lp = sensor(&n.pose, laser);
-            let (sx, sy) = (lp.x * inv - x0 as f64, lp.y * inv - y0 as f64);
+            let (sx, sy, theta) = sensor_in_cells(n, laser, params, self);
             for i in 0..n.scan.len() {
                 let Some((r, true)) = beam_end(&n.scan, i, params) else {
                     continue;
                 };
-                let a = lp.theta + n.scan.angle(i);
+                let a = theta + n.scan.angle(i);
                 let (cx, cy) = ((sx + r * a.cos() * inv).floor() as i64, (sy + r * a.sin() * inv).floor() as i64);
-                if cx >= 0 && cy >= 0 && (cx as usize) < w && (cy as usize) < h {
-                    let k = cy as usize * w + cx as usize;
-                    hits[k] = hits[k].saturating_add(1);
+                if let Some(k) = self.index(cx, cy) {
+                    self.hits[k] = self.hits[k].saturating_add(1);
                 }
             }
         }
     }
-    // Pass 3: trace, in parallel runs of nodes, each counting into its own arrays (the counts are sums, so
-    // the map does not depend on the split). With `wall_hits` the traces read pass 2's hits and add none.
-    let trace = |run: &[&TrajectoryNode]| -> (Vec<u32>, Vec<u32>) {
-        let mut visits = vec![0u32; w * h];
-        let mut ends = if wall == 0 { vec![0u32; w * h] } else { Vec::new() };
-        for n in run {
-            let lp = sensor(&n.pose, laser);
-            let (sx, sy) = (lp.x * inv - x0 as f64, lp.y * inv - y0 as f64);
-            for i in 0..n.scan.len() {
-                let Some((r, hit)) = beam_end(&n.scan, i, params) else {
-                    continue;
-                };
-                let a = lp.theta + n.scan.angle(i);
-                let (ex, ey) = (sx + r * a.cos() * inv, sy + r * a.sin() * inv);
-                let trav = CellTraversal::new(sx, sy, ex, ey);
-                let end = trav.end_cell();
-                for (cx, cy) in trav {
-                    if cx < 0 || cy < 0 || cx as usize >= w || cy as usize >= h {
+
+    /// Pass 3: the beams of `nodes` traced, in parallel runs of nodes, each counting into its own arrays (the
+    /// counts are sums, so they do not depend on the split). With `wall_hits` the traces read the hits and add
+    /// none.
+    pub(crate) fn add_traces(&mut self, nodes: &[&TrajectoryNode], laser: &Xyt, params: &MapParams) {
+        let wall = params.wall_hits;
+        let (len, this) = (self.w * self.h, &*self);
+        let trace = |run: &[&TrajectoryNode]| -> (Vec<u32>, Vec<u32>) {
+            let mut visits = vec![0u32; len];
+            let mut ends = if wall == 0 { vec![0u32; len] } else { Vec::new() };
+            for n in run {
+                let at = sensor_in_cells(n, laser, params, this);
+                for i in 0..n.scan.len() {
+                    let Some((trav, hit)) = beam_cells(n, i, at, params) else {
                         continue;
-                    }
-                    let k = cy as usize * w + cx as usize;
-                    visits[k] = visits[k].saturating_add(1);
-                    if (cx, cy) == end {
-                        if hit && wall == 0 {
-                            ends[k] = ends[k].saturating_add(1);
+                    };
+                    let end = trav.end_cell();
+                    for (cx, cy) in trav {
+                        let Some(k) = this.index(cx, cy) else {
+                            continue;
+                        };
+                        visits[k] = visits[k].saturating_add(1);
+                        if (cx, cy) == end {
+                            if hit && wall == 0 {
+                                ends[k] = ends[k].saturating_add(1);
+                            }
+                        } else if wall > 0 && this.hits[k] >= wall {
+                            // a wall (or glass) that other beams ended on: this beam went through it, so the
+                            // space beyond is not known to be free from here
+                            break;
                         }
-                    } else if wall > 0 && hits[k] >= wall {
-                        // a wall (or glass) that other beams ended on: this beam went through it, so the space
-                        // beyond is not known to be free from here
-                        break;
                     }
                 }
             }
+            (visits, ends)
+        };
+        let run = nodes.len().div_ceil(rayon::current_num_threads().max(1)).max(1);
+        let Some((visits, ends)) = nodes.par_chunks(run).map(trace).reduce_with(|(mut v, mut e), (v2, e2)| {
+            add(&mut v, &v2);
+            add(&mut e, &e2);
+            (v, e)
+        }) else {
+            return;
+        };
+        add(&mut self.visits, &visits);
+        add(&mut self.hits, &ends);
+    }
+
+    /// The grid: a visited cell is occupied when hits/visits exceeds `occ_thresh`, free otherwise.
+    pub(crate) fn grid(&self, params: &MapParams) -> Option<OccupancyGrid> {
+        let cells: Vec<f32> = self
+            .hits
+            .iter()
+            .zip(&self.visits)
+            .map(|(&hi, &v)| {
+                if v == 0 {
+                    0.0
+                } else if hi as f64 > params.occ_thresh * v as f64 {
+                    ROS_LOGODDS_LIMIT
+                } else {
+                    -ROS_LOGODDS_LIMIT
+                }
+            })
+            .collect();
+        let origin = pose(self.x0 as f64 * params.delta, self.y0 as f64 * params.delta, 0.0);
+        OccupancyGrid::from_cells(self.w, self.h, params.delta, origin, cells).ok()
+    }
+
+    /// The counts of `nodes` from nothing; `Ok(None)`: nothing to map; `Err(())`: beyond core's cell limit.
+    pub(crate) fn of(nodes: &[&TrajectoryNode], laser: &Xyt, params: &MapParams) -> Result<Option<Counts>, ()> {
+        let Some(bounds) = cell_bounds(nodes, laser, params) else {
+            return Ok(None);
+        };
+        let mut c = Counts::zeros(bounds).ok_or(())?;
+        if params.wall_hits > 0 {
+            c.add_hits(nodes, laser, params);
         }
-        (visits, ends)
-    };
-    let add = |into: &mut [u32], from: &[u32]| into.iter_mut().zip(from).for_each(|(a, b)| *a = a.saturating_add(*b));
-    let run = nodes.len().div_ceil(rayon::current_num_threads().max(1)).max(1);
-    let (visits, ends) = nodes.par_chunks(run).map(trace).reduce_with(|(mut v, mut e), (v2, e2)| {
-        add(&mut v, &v2);
-        add(&mut e, &e2);
-        (v, e)
-    })?;
-    add(&mut hits, &ends);
-    let cells: Vec<f32> = hits
-        .iter()
-        .zip(&visits)
-        .map(|(&hi, &v)| {
-            if v == 0 {
-                0.0
-            } else if hi as f64 > params.occ_thresh * v as f64 {
-                ROS_LOGODDS_LIMIT
-            } else {
-                -ROS_LOGODDS_LIMIT
-            }
-        })
-        .collect();
-    let origin = pose(x0 as f64 * params.delta, y0 as f64 * params.delta, 0.0);
-    OccupancyGrid::from_cells(w, h, params.delta, origin, cells).ok()
+        c.add_traces(nodes, laser, params);
+        Ok(Some(c))
+    }
+}
+
+/// `into += from`, cell by cell.
+fn add(into: &mut [u32], from: &[u32]) {
+    into.iter_mut().zip(from).for_each(|(a, b)| *a = a.saturating_add(*b));
+}
+
+/// A 1×1 unknown grid: the map of nothing.
+pub(crate) fn empty_map(params: &MapParams) -> Option<OccupancyGrid> {
+    OccupancyGrid::new(1, 1, params.delta, pose(0.0, 0.0, 0.0)).ok()
+}
+
+/// Builds the map of a trajectory from scratch (nodes in any order; order does not change the counts): the
+/// reference [`IncrementalMap`](crate::incremental_map::IncrementalMap) is tested against.
+///
+/// Returns a 1×1 unknown grid when there is nothing to map, and `None` when the map would exceed
+/// core's cell limit.
+#[cfg(test)]
+pub(crate) fn build_map(nodes: &[&TrajectoryNode], laser: &Xyt, params: &MapParams) -> Option<OccupancyGrid> {
+    match Counts::of(nodes, laser, params) {
+        Ok(Some(c)) => c.grid(params),
+        Ok(None) => empty_map(params),
+        Err(()) => None,
+    }
 }
 
 #[cfg(test)]

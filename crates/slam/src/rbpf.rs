@@ -3,9 +3,9 @@
 use crate::backend::{Correction, Hypotheses, SlamBackend};
 use crate::calibration::{CalibrationMatch, OdometryCalibration};
 use crate::error::SlamError;
+use crate::incremental_map::IncrementalMap;
 use crate::loop_closure::LoopClosureReport;
 use crate::loop_graph::LoopGraph;
-use crate::map_build::build_map;
 use crate::motion::MotionModel;
 use crate::outcome::{Counters, SkipReason, UpdateOutcome, UpdateStats};
 use crate::params::SlamParams;
@@ -99,6 +99,8 @@ pub struct Rbpf {
     /// The online loop closure's pose graph (`loop_closure.enabled` and `loop_closure.online`): the
     /// trajectory and the output map are its; the particles are re-anchored on it when it moves.
     graph: Option<LoopGraph>,
+    /// The output map, kept to be extended by the next call of [`Rbpf::map`] while the trajectory only grows.
+    map: IncrementalMap,
 }
 
 impl Rbpf {
@@ -140,6 +142,7 @@ impl Rbpf {
             counters: Counters::default(),
             corrections: Vec::new(),
             graph,
+            map: IncrementalMap::default(),
         })
     }
 
@@ -615,11 +618,17 @@ impl Rbpf {
     /// Rebuilt from the best particle's trajectory on every call (like GMapping's ROS node does every
     /// `map_update_interval`): cost grows with the scans processed, so call it when a map is needed.
     pub fn map(&self) -> Result<OccupancyGrid, SlamError> {
+        // Oldest first, so a trajectory that grew since the last call extends the last map.
         let nodes: Vec<&TrajectoryNode> = match &self.graph {
             Some(g) => g.nodes().iter().collect(),
-            None => ancestry(&self.particles[self.best_index()].node).collect(),
+            None => {
+                let mut n: Vec<&TrajectoryNode> = ancestry(&self.particles[self.best_index()].node).collect();
+                n.reverse();
+                n
+            }
         };
-        build_map(&nodes, &self.laser, &self.params.map)
+        self.map
+            .map(&nodes, &self.laser, &self.params.map)
             .ok_or_else(|| SlamError::MapTooLarge("the trajectory's map exceeds core's grid size limit".into()))
     }
 

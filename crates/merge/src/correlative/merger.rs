@@ -135,12 +135,23 @@ impl Merger for CorrelativeMerger {
     fn align(&self, a: &OccupancyGrid, b: &OccupancyGrid) -> Result<Alignment, Box<NoAlignment>> {
         let p = &self.params;
         let mut timings = BTreeMap::new();
-        let (poses, points_b) = self.answers(a, b, &mut timings).map_err(NoAnswer::into_inner)?;
-        if p.answer.cross_check {
+        // The search the other way round does not depend on this one's answer: with threads, both at once.
+        let other_way = CorrelativeMerger { contact: self.contact.map(|c| c.swapped()), ..self.clone() };
+        let back = || {
             let t = Instant::now();
-            let other_way = CorrelativeMerger { contact: self.contact.map(|c| c.swapped()), ..self.clone() };
-            let back = other_way.answers(b, a, &mut BTreeMap::new());
-            timings.insert("cross_check".into(), ms(t));
+            (other_way.answers(b, a, &mut BTreeMap::new()), ms(t))
+        };
+        let (forward, back) = match (p.answer.cross_check, p.parallel) {
+            (false, _) => (self.answers(a, b, &mut timings), None),
+            (true, false) => (self.answers(a, b, &mut timings), Some(back())),
+            (true, true) => {
+                let (forward, back) = rayon::join(|| self.answers(a, b, &mut timings), back);
+                (forward, Some(back))
+            }
+        };
+        let (poses, points_b) = forward.map_err(NoAnswer::into_inner)?;
+        if let Some((back, took)) = back {
+            timings.insert("cross_check".into(), took);
             if let Some(reason) = cross_check_refusal(&poses[0], &points_b, back, p.search.distinct_m) {
                 return Err(fail(reason, timings));
             }

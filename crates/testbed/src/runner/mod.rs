@@ -38,6 +38,9 @@ pub fn merger_for(algorithm: Algorithm, scenario: &Scenario) -> MergerConfig {
         candidates: m.candidates,
         hypotheses: m.hypotheses,
         wall_dilation: m.wall_dilation,
+        // The run waits for its merges (online attempts block the step): each may use every core; trials run side
+        // by side share rayon's threads.
+        parallel: true,
         ..MergerConfig::new(algorithm, scenario.seed)
     }
 }
