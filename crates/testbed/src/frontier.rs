@@ -10,8 +10,7 @@
 
 use mrslam_core::{CellState, OccupancyGrid, Pose2};
 use nalgebra::Point2;
-use std::cmp::Reverse;
-use std::collections::BinaryHeap;
+use rayon::prelude::*;
 
 /// Unknown cells among a frontier cell's eight neighbours, at least.
 pub const FRONTIER_MIN_UNKNOWN: usize = 3;
@@ -26,6 +25,9 @@ pub const PATH_SPACING: f64 = 0.4;
 const STEP_COST: u32 = 10;
 /// Extra cost of a step onto a cell at the hard clearance; it falls linearly to 0 at the preferred clearance.
 const SQUEEZE_COST: f64 = 20.0;
+/// Buckets of the search's queue: more than the dearest step's cost ([`STEP_COST`] + [`SQUEEZE_COST`]).
+const RING: usize = 32;
+const _: () = assert!((STEP_COST as usize + SQUEEZE_COST as usize) < RING);
 
 /// How far a robot keeps from walls, metres: never nearer than `hard` (its half width and a margin, so that it
 /// fits through a door), and `preferred` where there is room (its bounding radius and a margin, so that it can
@@ -122,50 +124,11 @@ impl WallDistance {
                 }
             }
         }
-        // Along each row: the lower envelope of the parabolas (x - q)² + g(q)².
+        // Along each row: the lower envelope of the parabolas (x - q)² + g(q)²; the rows side by side.
         let mut d2 = vec![FAR; w * h];
-        let mut v = vec![0usize; w];
-        let mut z = vec![0.0f64; w + 1];
-        for y in 0..h {
-            let row = &g[y * w..(y + 1) * w];
-            let f = |q: usize| {
-                let gq = row[q] as f64;
-                gq * gq + (q * q) as f64
-            };
-            let mut k: Option<usize> = None;
-            for q in (0..w).filter(|&q| row[q] != FAR) {
-                let Some(mut kk) = k else {
-                    k = Some(0);
-                    v[0] = q;
-                    z[0] = f64::NEG_INFINITY;
-                    z[1] = f64::INFINITY;
-                    continue;
-                };
-                let fq = f(q);
-                let mut s = (fq - f(v[kk])) / (2.0 * (q - v[kk]) as f64);
-                // z[0] is minus infinity: the loop stops at kk = 0 at the latest.
-                while s <= z[kk] {
-                    kk -= 1;
-                    s = (fq - f(v[kk])) / (2.0 * (q - v[kk]) as f64);
-                }
-                kk += 1;
-                v[kk] = q;
-                z[kk] = s;
-                z[kk + 1] = f64::INFINITY;
-                k = Some(kk);
-            }
-            if k.is_none() {
-                continue;
-            }
-            let mut j = 0;
-            for q in 0..w {
-                while z[j + 1] < q as f64 {
-                    j += 1;
-                }
-                let (dx, gy) = (q.abs_diff(v[j]) as u64, row[v[j]] as u64);
-                d2[y * w + q] = (dx * dx + gy * gy).min(FAR as u64 - 1) as u32;
-            }
-        }
+        d2.par_chunks_mut(w.max(1))
+            .zip(g.par_chunks(w.max(1)))
+            .for_each_init(|| (vec![0usize; w], vec![0.0f64; w + 1]), |(v, z), (out, row)| envelope(row, out, v, z));
         WallDistance { width: w, height: h, d2 }
     }
 
@@ -183,6 +146,48 @@ impl WallDistance {
     /// True when the transform was computed on a grid of `map`'s size.
     fn fits(&self, map: &OccupancyGrid) -> bool {
         self.width == map.width() && self.height == map.height()
+    }
+}
+
+/// One row of the distance transform: `out[q]` the least (x - q)² + row[x]² over the columns x (`FAR` columns
+/// have no occupied cell in their column and are left out); `v`, `z`: the envelope's scratch (w and w + 1 long).
+fn envelope(row: &[u32], out: &mut [u32], v: &mut [usize], z: &mut [f64]) {
+    let f = |q: usize| {
+        let gq = row[q] as f64;
+        gq * gq + (q * q) as f64
+    };
+    let mut k: Option<usize> = None;
+    for q in (0..row.len()).filter(|&q| row[q] != FAR) {
+        let Some(mut kk) = k else {
+            k = Some(0);
+            v[0] = q;
+            z[0] = f64::NEG_INFINITY;
+            z[1] = f64::INFINITY;
+            continue;
+        };
+        let fq = f(q);
+        let mut s = (fq - f(v[kk])) / (2.0 * (q - v[kk]) as f64);
+        // z[0] is minus infinity: the loop stops at kk = 0 at the latest.
+        while s <= z[kk] {
+            kk -= 1;
+            s = (fq - f(v[kk])) / (2.0 * (q - v[kk]) as f64);
+        }
+        kk += 1;
+        v[kk] = q;
+        z[kk] = s;
+        z[kk + 1] = f64::INFINITY;
+        k = Some(kk);
+    }
+    if k.is_none() {
+        return;
+    }
+    let mut j = 0;
+    for (q, o) in out.iter_mut().enumerate() {
+        while z[j + 1] < q as f64 {
+            j += 1;
+        }
+        let (dx, gy) = (q.abs_diff(v[j]) as u64, row[v[j]] as u64);
+        *o = (dx * dx + gy * gy).min(FAR as u64 - 1) as u32;
     }
 }
 
@@ -241,39 +246,52 @@ impl Reach {
         parent[s] = s as u32;
         steps[s] = 0;
         cost[s] = 0;
-        // Cheapest first, the lower index on ties: the search does not depend on the heap's order.
-        let mut queue = BinaryHeap::from([Reverse((0u32, s as u32))]);
+        // Cheapest first, the lower index on ties. A step costs 1 to RING - 1 cost units, so the cells queued at
+        // cost k are all queued before the search reaches k (Dial's buckets, a ring of them): each bucket is
+        // sorted and run in index order, the order a heap of (cost, index) pops them in.
+        let mut ring: Vec<Vec<u32>> = vec![Vec::new(); RING];
+        ring[0].push(s as u32);
+        let (mut k, mut queued) = (0u32, 1usize);
         let mut found = None;
-        while let Some(Reverse((k, c))) = queue.pop() {
-            let c = c as usize;
-            if k > cost[c] {
-                continue;
-            }
-            let (cx, cy) = ((c % w) as i64, (c / w) as i64);
-            if stop(cx, cy) {
-                found = Some(c);
-                break;
-            }
-            for (dx, dy) in [(1i64, 0i64), (-1, 0), (0, 1), (0, -1)] {
-                let (nx, ny) = (cx + dx, cy + dy);
-                if !map.contains_cell(nx, ny) {
-                    continue;
+        'search: while queued > 0 {
+            let mut bucket = std::mem::take(&mut ring[k as usize % RING]);
+            queued -= bucket.len();
+            bucket.sort_unstable();
+            for &c in &bucket {
+                let c = c as usize;
+                if k > cost[c] {
+                    continue; // queued again since at a lower cost
                 }
-                let n = ny as usize * w + nx as usize;
-                let st = CellState::from_log_odds(cells[n]);
-                let passable = if on_robot(nx, ny) {
-                    st != CellState::Occupied
-                } else {
-                    st == CellState::Free && !walls.blocked(n, r)
-                };
-                let kn = k + step_cost(n);
-                if passable && kn < cost[n] {
-                    cost[n] = kn;
-                    parent[n] = c as u32;
-                    steps[n] = steps[c] + 1;
-                    queue.push(Reverse((kn, n as u32)));
+                let (cx, cy) = ((c % w) as i64, (c / w) as i64);
+                if stop(cx, cy) {
+                    found = Some(c);
+                    break 'search;
+                }
+                for (dx, dy) in [(1i64, 0i64), (-1, 0), (0, 1), (0, -1)] {
+                    let (nx, ny) = (cx + dx, cy + dy);
+                    if !map.contains_cell(nx, ny) {
+                        continue;
+                    }
+                    let n = ny as usize * w + nx as usize;
+                    let st = CellState::from_log_odds(cells[n]);
+                    let passable = if on_robot(nx, ny) {
+                        st != CellState::Occupied
+                    } else {
+                        st == CellState::Free && !walls.blocked(n, r)
+                    };
+                    let kn = k + step_cost(n);
+                    if passable && kn < cost[n] {
+                        cost[n] = kn;
+                        parent[n] = c as u32;
+                        steps[n] = steps[c] + 1;
+                        ring[kn as usize % RING].push(n as u32);
+                        queued += 1;
+                    }
                 }
             }
+            bucket.clear();
+            ring[k as usize % RING] = bucket;
+            k += 1;
         }
         Some((Reach { width: w, resolution: map.resolution(), start: s, parent, steps }, found))
     }
