@@ -38,9 +38,6 @@ pub fn merger_for(algorithm: Algorithm, scenario: &Scenario) -> MergerConfig {
         candidates: m.candidates,
         hypotheses: m.hypotheses,
         wall_dilation: m.wall_dilation,
-        // The run waits for its merges (online attempts block the step): each may use every core; trials run side
-        // by side share rayon's threads.
-        parallel: true,
         ..MergerConfig::new(algorithm, scenario.seed)
     }
 }
@@ -59,10 +56,12 @@ pub fn run(scenario: &Scenario, mut opts: RunOptions) -> Result<RunOutput, RunEr
     if let Some(v) = opts.viz.as_deref_mut() {
         record::viz_begin(v, &sim, &truth, &agents, &algorithms, scenario.team.is_some());
     }
-    let mut teams = scenario
-        .team
-        .as_ref()
-        .map(|setup| team::Teams::new(scenario, setup, &truth, merger_for(setup.merger, scenario).build()));
+    let mut teams = scenario.team.as_ref().map(|setup| {
+        // The run waits for its online attempts (they block the step): each may use every core (trials run
+        // side by side share rayon's threads); threads change no answer.
+        let merger = MergerConfig { parallel: true, ..merger_for(setup.merger, scenario) };
+        team::Teams::new(scenario, setup, &truth, merger.build())
+    });
     let steps = drive::drive(scenario, &mut sim, &mut agents, &truth, teams.as_mut(), &mut opts)?;
     let merge_at = sim.time();
     if let Some(v) = opts.viz.as_deref_mut() {
