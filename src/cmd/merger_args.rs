@@ -89,6 +89,9 @@ impl MergerArgs {
             // One merge has the machine to itself: the two maps' features on two threads (the studies, which run
             // merges side by side, keep one thread per merge).
             parallel: true,
+            // `sift` settles most maps a user brings (a real map's cuts: 0.33 s alone, 0.8 s waiting for
+            // `sift+boundary` beside it): the stages one after the other.
+            side_by_side: false,
             min_margin: self.min_margin,
             cross_check: !self.one_way,
             seed: self.seed,

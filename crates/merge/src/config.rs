@@ -32,6 +32,9 @@ pub struct MergerConfig {
     pub wall_dilation: usize,
     /// Detect and match the two maps' features on two threads (one merge with the machine to itself).
     pub parallel: bool,
+    /// A cascade runs `sift+boundary` beside `sift` ([`Cascade::side_by_side`]: for robots' maps, which `sift`
+    /// rarely settles).
+    pub side_by_side: bool,
     /// The correlative search's significance margin ([`AnswerParams::min_margin`](crate::AnswerParams::min_margin)).
     pub min_margin: f64,
     /// The correlative answer checked by the same search the other way round ([`AnswerParams::cross_check`](crate::AnswerParams::cross_check)).
@@ -55,6 +58,7 @@ impl Default for MergerConfig {
             hypotheses: sift.hypotheses,
             wall_dilation: sift.wall_dilation,
             parallel: sift.parallel,
+            side_by_side: false,
             min_margin: correlative.answer.min_margin,
             cross_check: correlative.answer.cross_check,
             seed: 0,
@@ -109,6 +113,9 @@ impl MergerConfig {
             Algorithm::Sift => Box::new(SiftMerger::new(self.sift())),
             Algorithm::Rmap => Box::new(RmapMerger::new(self.rmap())),
             Algorithm::Correlative => Box::new(CorrelativeMerger::new(self.correlative())),
+            Algorithm::Cascade if self.side_by_side => {
+                Box::new(Cascade::new(self.sift(), self.correlative()).side_by_side())
+            }
             Algorithm::Cascade => Box::new(Cascade::new(self.sift(), self.correlative())),
         }
     }

@@ -58,8 +58,9 @@ pub fn run(scenario: &Scenario, mut opts: RunOptions) -> Result<RunOutput, RunEr
     }
     let mut teams = scenario.team.as_ref().map(|setup| {
         // The run waits for its online attempts (they block the step): each may use every core (trials run
-        // side by side share rayon's threads); threads change no answer.
-        let merger = MergerConfig { parallel: true, ..merger_for(setup.merger, scenario) };
+        // side by side share rayon's threads), and robots' maps are rarely settled by `sift`, so the cascade
+        // runs `sift+boundary` beside it; neither changes an answer.
+        let merger = MergerConfig { parallel: true, side_by_side: true, ..merger_for(setup.merger, scenario) };
         team::Teams::new(scenario, setup, &truth, merger.build())
     });
     let steps = drive::drive(scenario, &mut sim, &mut agents, &truth, teams.as_mut(), &mut opts)?;
