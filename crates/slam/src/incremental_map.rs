@@ -62,17 +62,14 @@ impl IncrementalMap {
             drawn.extended += 1;
         } else {
             drawn.rebuilt += 1;
-            drawn.counts = match Counts::of(nodes, laser, params) {
-                Ok(c) => c,
-                Err(()) => {
-                    drawn.counts = None;
-                    drawn.nodes.clear();
-                    return None;
-                }
+            drawn.nodes.clear();
+            let Ok(counts) = Counts::of(nodes, laser, params) else {
+                drawn.counts = None; // beyond the cell limit: nothing kept to extend
+                return None;
             };
+            drawn.counts = counts;
             drawn.laser = Some(*laser);
             drawn.params = Some(*params);
-            drawn.nodes.clear();
         }
         let kept = drawn.nodes.len();
         drawn.nodes.extend(nodes[kept..].iter().map(|n| (n.scan.clone(), n.pose)));

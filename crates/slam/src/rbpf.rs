@@ -615,8 +615,9 @@ impl Rbpf {
 
     /// The best particle's map as a log-odds grid (occupied +2, free −2, unknown 0; see `map_build`).
     ///
-    /// Rebuilt from the best particle's trajectory on every call (like GMapping's ROS node does every
-    /// `map_update_interval`): cost grows with the scans processed, so call it when a map is needed.
+    /// Drawn from the best particle's trajectory (or the loop graph's) as GMapping's ROS node does every
+    /// `map_update_interval`; while that trajectory only grew since the last call, only its new scans are traced
+    /// (`incremental_map`), otherwise the whole trajectory is.
     pub fn map(&self) -> Result<OccupancyGrid, SlamError> {
         // Oldest first, so a trajectory that grew since the last call extends the last map.
         let nodes: Vec<&TrajectoryNode> = match &self.graph {

@@ -246,8 +246,8 @@ impl Reach {
         parent[s] = s as u32;
         steps[s] = 0;
         cost[s] = 0;
-        // Cheapest first, the lower index on ties. A step costs 1 to RING - 1 cost units, so the cells queued at
-        // cost k are all queued before the search reaches k (Dial's buckets, a ring of them): each bucket is
+        // Cheapest first, the lower index on ties. A step costs at least STEP_COST and less than RING, so the cells
+        // queued at cost k are all queued before the search reaches k (Dial's buckets, a ring of them): each bucket is
         // sorted and run in index order, the order a heap of (cost, index) pops them in.
         let mut ring: Vec<Vec<u32>> = vec![Vec::new(); RING];
         ring[0].push(s as u32);

@@ -136,9 +136,9 @@ impl Merger for CorrelativeMerger {
         let p = &self.params;
         let mut timings = BTreeMap::new();
         // The search the other way round does not depend on this one's answer: with threads, both at once.
-        let other_way = CorrelativeMerger { contact: self.contact.map(|c| c.swapped()), ..self.clone() };
         let back = || {
             let t = Instant::now();
+            let other_way = CorrelativeMerger { contact: self.contact.map(|c| c.swapped()), ..self.clone() };
             (other_way.answers(b, a, &mut BTreeMap::new()), ms(t))
         };
         let (forward, back) = match (p.answer.cross_check, p.parallel) {
