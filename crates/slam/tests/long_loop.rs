@@ -1,7 +1,8 @@
 //! A loop of more than 200 m in a building of look-alike corridors, driven with drifting odometry: the default
 //! preset (`matched`, loop closure while driving) closes it on every seed, and the map it holds right after the
 //! robot is back where it started is already loop-closed: as good as the optimisation at the end of the data
-//! makes it. How close to the truth that is, along corridors that look alike, is a goal not met yet (ignored).
+//! makes it; and at the end of the data its map is within 30 cm of the truth where the robot ends and within a metre
+//! everywhere, along corridors that look alike.
 #![allow(clippy::unwrap_used, reason = "a test: a failed unwrap names the problem")]
 
 use mrslam_core::pose::relative;
@@ -121,8 +122,10 @@ fn a_200_m_loop_is_closed_on_every_seed_while_driving() {
     assert!(failed.is_empty(), "{failed:#?}");
 }
 
+/// 2026-12-07: seeds 0-2 end 0.14, 0.24, 0.30 m off, worst poses 0.76, 0.76, 0.61 m (before loop edges were held from
+/// the submap's node nearest the match: 0.13, 0.36, 0.34 m and 0.85, 1.05, 0.70 m). What is left at the end is the
+/// first pass's own drift up to the place the loop closes on, which no loop edge can see.
 #[test]
-#[ignore = "not met (2026-12-06): seeds 1 and 2 end 0.34-0.36 m off and seed 1's far corner 1.05 m, along corridors that look alike; the next step of [slam-general]"]
 fn a_200_m_loop_of_look_alike_corridors_is_mapped_within_30_cm_at_its_end() {
     let mut failed = Vec::new();
     for o in outcomes() {

@@ -1,11 +1,13 @@
 //! Accuracy and speed harness on the synthetic runs of the crate's tests:
-//! `cargo run --release -p mrslam-dev --bin office -- [hokuyo|rplidar|corridor] [name=value ...]`.
+//! `cargo run --release -p mrslam-dev --bin office -- [hokuyo|rplidar|corridor|ring] [name=value ...]`.
 //!
 //! Diagnostics by environment variable: `DRIFT=scale,heading_per_m,sigma_trans,sigma_rot` (odometry model),
 //! `SIMSEED=S` (the Hokuyo data's seed, 11 as in the test), `SIMLIKE` (the simulator's lidar noise and
 //! mount), `LIDAR_RANGE`, `LIDAR_FOV`, `LIDAR_NOISE`,
 //! `LIDAR_NOISE_PER_M`, `LIDAR_DROPOUT` (Hokuyo), `TRACE[=N]` (every N-th pose's error), `INCREMENTS` (per-leg increment errors of SLAM and
-//! odometry), `ALL` (every particle's error and log-likelihood).
+//! odometry), `ALL` (every particle's error and log-likelihood), `CLOSE` (the end-of-data loop closure first), `EDGES`
+//! (each loop edge's error in the trajectory held), `ORACLE=chain_sigma,chain_heading_sigma` (the trajectory closed
+//! by loop edges taken from the truth: what the pose graph's noise model makes of perfect loop edges).
 #![allow(clippy::unwrap_used, reason = "a development aid / test: a failed unwrap names the problem")]
 
 use mrslam_core::Xyt;
@@ -66,6 +68,19 @@ fn main() {
                 9,
             )
         }
+        "ring" => {
+            // the data of crates/slam/tests/long_loop.rs: a 220 m loop of look-alike corridors, SICK-class lidar
+            let (w, h, c) = (70.0, 40.0, 3.0);
+            let m = synthetic::ring_building(w, h, c, 3);
+            let path = synthetic::waypoint_path(&synthetic::ring_loop(w, h, c, 30.0), 0.1, 0.1);
+            let drift = Drift { scale: 0.03, heading_per_m: 0.02, sigma_trans: 0.05, sigma_rot: 0.05 };
+            let sim_seed = std::env::var("SIMSEED").ok().and_then(|v| v.parse().ok()).unwrap_or(7);
+            (
+                synthetic::simulate(&m, &path, 0.1, &Lidar::sick(), pose(0.1, 0.0, 0.0), &drift, sim_seed),
+                SlamParams::matched(),
+                0,
+            )
+        }
         "corridor" => {
             let m = synthetic::corridor_map(52.0);
             let path = synthetic::waypoint_path(&[(1.0, 2.5), (51.0, 2.5)], 0.05, 0.1);
@@ -120,6 +135,23 @@ fn main() {
         let t1 = std::time::Instant::now();
         if f.process(o, s).unwrap().is_processed() {
             times.push(t1.elapsed().as_secs_f64() * 1e3);
+        }
+    }
+    if let Ok(v) = std::env::var("ORACLE") {
+        oracle(&f.trajectory(), &run.truth, &v);
+    }
+    if std::env::var("CLOSE").is_ok() {
+        println!("{:?}", f.close_loops());
+    }
+    if std::env::var("EDGES").is_ok() {
+        // each loop edge's relative pose in the trajectory held against the truth's (the `to` node's frame)
+        let traj = f.trajectory();
+        let t_at = |stamp: f64| run.truth[run.truth.binary_search_by(|(s, _)| s.total_cmp(&stamp)).unwrap()].1;
+        for (a, b) in f.loop_edges() {
+            let est = relative(&traj[a].1, &traj[b].1);
+            let tru = relative(&t_at(traj[a].0), &t_at(traj[b].0));
+            let e = Xyt::from_pose(&(tru.inverse() * est));
+            println!("edge {a:3} -> {b:3}: err ({:+.3},{:+.3},{:+.4})", e.x, e.y, e.theta);
         }
     }
     let secs = t.elapsed().as_secs_f64();
@@ -199,4 +231,52 @@ fn main() {
         f.counters().resamples,
         times[times.len() / 2]
     );
+}
+
+/// The filter's trajectory as a pose graph (its increments, `loop_chain_*` information) closed by loop edges taken
+/// from the truth (each node of a later pass to the nearest node passed 20+ m of driving earlier, within 1 m):
+/// what the graph's noise model makes of perfect loop edges. `spec` = "chain_sigma,chain_heading_sigma".
+fn oracle(traj: &[(f64, Pose2)], truth: &[(f64, Pose2)], spec: &str) {
+    use mrslam_matching::Information;
+    use mrslam_matching::pose_graph::{Edge, optimize};
+    let v: Vec<f64> = spec.split(',').map(|x| x.parse().unwrap()).collect();
+    let t_at = |stamp: f64| truth[truth.binary_search_by(|(s, _)| s.total_cmp(&stamp)).unwrap()].1;
+    let tr: Vec<Pose2> = traj.iter().map(|(s, _)| t_at(*s)).collect();
+    let mut poses: Vec<Xyt> = traj.iter().map(|(_, p)| Xyt::from_pose(p)).collect();
+    let mut edges = Vec::new();
+    let mut travel = vec![0.0];
+    for k in 1..traj.len() {
+        let d = (tr[k].translation.vector - tr[k - 1].translation.vector).norm();
+        travel.push(travel[k - 1] + d);
+        edges.push(Edge {
+            from: k - 1,
+            to: k,
+            measured: Xyt::from_pose(&relative(&traj[k - 1].1, &traj[k].1)),
+            information: Information([1.0 / (v[0] * v[0]), 0.0, 0.0, 1.0 / (v[0] * v[0]), 0.0, 1.0 / (v[1] * v[1])]),
+            huber: f64::INFINITY,
+        });
+    }
+    let mut loops = 0;
+    for k in 0..traj.len() {
+        let best = (0..k)
+            .filter(|&j| travel[k] - travel[j] > 20.0)
+            .map(|j| (j, (tr[k].translation.vector - tr[j].translation.vector).norm()))
+            .min_by(|a, b| a.1.total_cmp(&b.1));
+        if let Some((j, d)) = best
+            && d < 1.0
+        {
+            loops += 1;
+            edges.push(Edge {
+                from: j,
+                to: k,
+                measured: Xyt::from_pose(&relative(&tr[j], &tr[k])),
+                information: Information([2500.0, 0.0, 0.0, 2500.0, 0.0, 40000.0]),
+                huber: f64::INFINITY,
+            });
+        }
+    }
+    let s = optimize(&mut poses, &edges, 100).unwrap();
+    let est: Vec<(f64, Pose2)> = traj.iter().zip(&poses).map(|((st, _), p)| (*st, p.to_pose())).collect();
+    let (rms, max) = errors(&est, truth);
+    println!("oracle ({loops} loop edges, {} iterations): rms {rms:.4} max {max:.3}", s.iterations);
 }

@@ -316,7 +316,28 @@ impl LoopGraph {
         if found.rival >= self.params.max_rival && !self.agrees_with_rivalled(i, k, &predicted, &found.pose) {
             return None;
         }
-        refine_to_edge(&grids, &self.matcher, scan, &found, &self.params, (s.first, k))
+        let edge = refine_to_edge(&grids, &self.matcher, scan, &found, &self.params, (s.first, k))?;
+        Some(self.held_from_nearest_node(edge, s))
+    }
+
+    /// The loop edge `edge` (submap `s`'s first node → the scan's node, measured in the submap's frame) re-expressed
+    /// from the submap's node nearest to where the scan matched.
+    ///
+    /// The scan matched the walls near that node, drawn from the node's pose in the submap; held from the submap's
+    /// first node, the edge would also carry the drift between the two within the submap (a submap 15 m long bent
+    /// by a hundredth of a radian puts its far end 0.15 m off), which the chain between them already holds.
+    fn held_from_nearest_node(&self, edge: Edge, s: Submap) -> Edge {
+        let anchor = self.nodes[s.first].pose;
+        let local = in_anchor_frame(&anchor, &(s.first..=s.last).map(|n| self.nodes[n].pose).collect::<Vec<_>>());
+        let m = edge.measured;
+        let (j, at) = local
+            .iter()
+            .enumerate()
+            .min_by(|a, b| (a.1.x - m.x).hypot(a.1.y - m.y).total_cmp(&(b.1.x - m.x).hypot(b.1.y - m.y)))
+            .map(|(i, p)| (s.first + i, *p))
+            .unwrap_or((s.first, Xyt { x: 0.0, y: 0.0, theta: 0.0 }));
+        // The information is of the scan's pose in its own frame (see `Edge::information`): the same from any node.
+        Edge { from: j, measured: in_anchor_frame(&at, &[m])[0], ..edge }
     }
 
     /// Records an answer the rival check refused (node `k` against submap `i`: found at `pose` where the graph
@@ -517,6 +538,35 @@ mod tests {
         // The move is taken in the predicted pose's frame: a prediction turned a half turn moves the answer with it.
         let turned = Xyt { x: 0.0, y: 0.0, theta: std::f64::consts::PI };
         assert!(!graph.agrees_with_rivalled(4, 4, &turned, &at(1.2, -1.3)));
+    }
+
+    #[test]
+    fn a_loop_edge_is_held_from_the_node_whose_walls_the_scan_matched() {
+        // Every node turned 0.0035 rad too far: each submap is bent, its far end 0.05 rad off its first node.
+        let (truth, scans, laser) = office_nodes();
+        let p = crate::SlamParams::matched();
+        let map = MapParams { max_range: 30.0, max_urange: 30.0, ..p.map };
+        let mut graph = LoopGraph::new(p.loop_closure, &p.matcher, map, laser);
+        for k in 0..truth.len() {
+            let mut z = Xyt::from_pose(&if k == 0 { truth[0] } else { relative(&truth[k - 1], &truth[k]) });
+            z.theta += if k == 0 { 0.0 } else { 0.0035 };
+            graph.add(k as f64, z, scans[k].clone());
+        }
+        assert!(graph.loops.len() >= 3, "{:?}", graph.report());
+        for e in &graph.loops {
+            let s = graph.submaps.iter().find(|s| (s.first..=s.last).contains(&e.from)).unwrap();
+            // The edge's node is the submap's nearest to the scan's match...
+            let near = |n: usize| {
+                (graph.nodes[n].pose.x - graph.nodes[e.to].pose.x)
+                    .hypot(graph.nodes[n].pose.y - graph.nodes[e.to].pose.y)
+            };
+            assert!((s.first..=s.last).all(|n| near(e.from) <= near(n) + 1.0), "edge {} -> {}", e.from, e.to);
+            // ... and the edge says where the scan was seen from it as the truth does.
+            let t = Xyt::from_pose(&relative(&truth[e.from], &truth[e.to]));
+            let m = e.measured;
+            let (dt, dh) = ((m.x - t.x).hypot(m.y - t.y), mrslam_core::pose::normalize_angle(m.theta - t.theta).abs());
+            assert!(dt < 0.1 && dh < 0.01, "edge {} -> {}: {dt:.3} m, {dh:.4} rad off the truth", e.from, e.to);
+        }
     }
 
     #[test]
