@@ -1,5 +1,6 @@
 //! A joined team's exploration: the frontiers of its merged map assigned over its exploring robots (Burgard et
-//! al. 2005), re-planned every few seconds and whenever a robot reaches its goal or the team grows.
+//! al. 2005), re-planned every few seconds and whenever a robot reaches its goal or the team grows (a robot the
+//! last plan gave no frontier waits for the next plan on the clock).
 
 use super::agent::Agent;
 use super::options::RunError;
@@ -17,6 +18,10 @@ pub(super) struct Planner {
     next: Vec<f64>,
     /// Per team root: the time of its last plan.
     last: Vec<f64>,
+    /// Per robot: its team's last plan gave it no frontier. Its path is then empty, so it asks for a plan at every
+    /// step; it waits for the team's next plan on the clock instead (or the team's growing), as no frontier was
+    /// left for it a moment ago.
+    unassigned: Vec<bool>,
     params: TeamParams,
 }
 
@@ -26,6 +31,7 @@ impl Planner {
         Planner {
             next: vec![0.0; robots],
             last: vec![f64::NEG_INFINITY; robots],
+            unassigned: vec![false; robots],
             params: TeamParams { assign: AssignParams { beta, ..AssignParams::default() }, ..TeamParams::default() },
         }
     }
@@ -52,7 +58,9 @@ impl Planner {
             if explorers.len() < 2 {
                 continue;
             }
-            let wants = explorers.iter().any(|&k| explorer(&agents[k]).is_some_and(Explorer::wants_plan));
+            let wants = explorers
+                .iter()
+                .any(|&k| !self.unassigned[k] && explorer(&agents[k]).is_some_and(Explorer::wants_plan));
             let due = t + 1e-9 >= self.next[root] || (wants && t >= self.last[root] + MIN_REPLAN_S);
             if !due {
                 continue;
@@ -90,6 +98,7 @@ impl Planner {
                     .collect(),
             });
             for (&k, plan) in explorers.iter().zip(plans) {
+                self.unassigned[k] = plan.is_none();
                 let (_, place) = teams.place(k);
                 let to_own = place.inverse();
                 let a = &mut agents[k];
