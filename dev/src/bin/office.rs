@@ -36,12 +36,16 @@ fn acceptance(map: &OccupancyGrid, truth: &OccupancyGrid, t0: &Pose2) -> f64 {
     a as f64 / (a + d).max(1) as f64
 }
 
+/// The true pose at `stamp` (a stamp of the run's data).
+fn truth_at(truth: &[(f64, Pose2)], stamp: f64) -> Pose2 {
+    truth[truth.binary_search_by(|(s, _)| s.total_cmp(&stamp)).unwrap()].1
+}
+
 fn errors(est: &[(f64, Pose2)], truth: &[(f64, Pose2)]) -> (f64, f64) {
     let t0 = truth[0].1;
     let (mut sum, mut max) = (0.0, 0.0f64);
     for (stamp, p) in est {
-        let k = truth.binary_search_by(|(s, _)| s.total_cmp(stamp)).unwrap();
-        let t = relative(&t0, &truth[k].1);
+        let t = relative(&t0, &truth_at(truth, *stamp));
         let d = (p.translation.vector - t.translation.vector).norm();
         sum += d * d;
         max = max.max(d);
@@ -146,7 +150,7 @@ fn main() {
     if std::env::var("EDGES").is_ok() {
         // each loop edge's relative pose in the trajectory held against the truth's (the `to` node's frame)
         let traj = f.trajectory();
-        let t_at = |stamp: f64| run.truth[run.truth.binary_search_by(|(s, _)| s.total_cmp(&stamp)).unwrap()].1;
+        let t_at = |stamp: f64| truth_at(&run.truth, stamp);
         for (a, b) in f.loop_edges() {
             let est = relative(&traj[a].1, &traj[b].1);
             let tru = relative(&t_at(traj[a].0), &t_at(traj[b].0));
@@ -165,11 +169,10 @@ fn main() {
             .enumerate()
             .step_by(std::env::var("TRACE").ok().and_then(|v| v.parse().ok()).unwrap_or(5))
         {
-            let k = run.truth.binary_search_by(|(s, _)| s.total_cmp(stamp)).unwrap();
-            let t = relative(&t0, &run.truth[k].1);
-            let e = t.inverse() * p;
+            let true_pose = truth_at(&run.truth, *stamp);
+            let e = relative(&t0, &true_pose).inverse() * p;
             let Xyt { x: ex, y: ey, theta: et } = Xyt::from_pose(&e);
-            let Xyt { x: tx, y: ty, .. } = Xyt::from_pose(&run.truth[k].1);
+            let Xyt { x: tx, y: ty, .. } = Xyt::from_pose(&true_pose);
             println!("{i:4} truth ({tx:5.1},{ty:5.1}) err ({ex:+.3},{ey:+.3},{et:+.4})");
         }
     }
@@ -177,7 +180,7 @@ fn main() {
         // per-update increment errors of the best trajectory and of odometry (robot frame: along-track,
         // cross-track, heading), summed per leg of the path (legs split where the true heading changes)
         let traj = f.trajectory();
-        let t_at = |stamp: f64| run.truth[run.truth.binary_search_by(|(s, _)| s.total_cmp(&stamp)).unwrap()].1;
+        let t_at = |stamp: f64| truth_at(&run.truth, stamp);
         let o_at = |stamp: f64| run.odometry.iter().find(|o| o.stamp == stamp).unwrap().pose;
         let (mut sum_s, mut sum_o) = ([0.0f64; 3], [0.0f64; 3]);
         let mut leg_start = 0;
@@ -240,8 +243,7 @@ fn oracle(traj: &[(f64, Pose2)], truth: &[(f64, Pose2)], spec: &str) {
     use mrslam_matching::Information;
     use mrslam_matching::pose_graph::{Edge, optimize};
     let v: Vec<f64> = spec.split(',').map(|x| x.parse().unwrap()).collect();
-    let t_at = |stamp: f64| truth[truth.binary_search_by(|(s, _)| s.total_cmp(&stamp)).unwrap()].1;
-    let tr: Vec<Pose2> = traj.iter().map(|(s, _)| t_at(*s)).collect();
+    let tr: Vec<Pose2> = traj.iter().map(|(s, _)| truth_at(truth, *s)).collect();
     let mut poses: Vec<Xyt> = traj.iter().map(|(_, p)| Xyt::from_pose(p)).collect();
     let mut edges = Vec::new();
     let mut travel = vec![0.0];
@@ -256,6 +258,8 @@ fn oracle(traj: &[(f64, Pose2)], truth: &[(f64, Pose2)], spec: &str) {
             huber: f64::INFINITY,
         });
     }
+    // Loop edges as sure as the loop closure's floor on its matches (`loop_sigma`, `loop_heading_sigma`).
+    let lc = mrslam_slam::LoopClosureParams::default();
     let mut loops = 0;
     for k in 0..traj.len() {
         let best = (0..k)
@@ -270,7 +274,14 @@ fn oracle(traj: &[(f64, Pose2)], truth: &[(f64, Pose2)], spec: &str) {
                 from: j,
                 to: k,
                 measured: Xyt::from_pose(&relative(&tr[j], &tr[k])),
-                information: Information([2500.0, 0.0, 0.0, 2500.0, 0.0, 40000.0]),
+                information: Information([
+                    1.0 / (lc.sigma * lc.sigma),
+                    0.0,
+                    0.0,
+                    1.0 / (lc.sigma * lc.sigma),
+                    0.0,
+                    1.0 / (lc.heading_sigma * lc.heading_sigma),
+                ]),
                 huber: f64::INFINITY,
             });
         }

@@ -335,7 +335,7 @@ impl LoopGraph {
             .enumerate()
             .min_by(|a, b| (a.1.x - m.x).hypot(a.1.y - m.y).total_cmp(&(b.1.x - m.x).hypot(b.1.y - m.y)))
             .map(|(i, p)| (s.first + i, *p))
-            .unwrap_or((s.first, Xyt { x: 0.0, y: 0.0, theta: 0.0 }));
+            .unwrap_or((s.first, Xyt::default())); // a submap is never empty
         // The information is of the scan's pose in its own frame (see `Edge::information`): the same from any node.
         Edge { from: j, measured: in_anchor_frame(&at, &[m])[0], ..edge }
     }
