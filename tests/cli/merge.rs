@@ -66,6 +66,28 @@ fn cut_plan(d: &Path, seed: u64, overlap: &str) {
 }
 
 #[test]
+fn sift_without_the_doubled_image_still_merges_a_cut() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    cut_plan(d, 21, "0.5");
+    let (a, b, path) = (d.join("a.yaml"), d.join("b.yaml"), d.join("report.json"));
+    let report = |extra: &[&str]| -> serde_json::Value {
+        let mut args = vec!["merge", p(&a), p(&b), "--algorithm", "sift", "--report"];
+        args.push(p(&path));
+        args.extend_from_slice(extra);
+        let o = mrslam(&args);
+        assert_eq!(o.status.code(), Some(0), "{extra:?}: {}{}", text(&o.stdout), text(&o.stderr));
+        serde_json::from_slice(&std::fs::read(&path).unwrap()).unwrap()
+    };
+    let (doubled, own) = (report(&[]), report(&["--no-upscale"]));
+    let t = |r: &serde_json::Value, k: &str| r["transform"][k].as_f64().unwrap();
+    assert!((t(&doubled, "x") - t(&own, "x")).abs() < 0.1 && (t(&doubled, "y") - t(&own, "y")).abs() < 0.1);
+    assert!((t(&doubled, "theta") - t(&own, "theta")).abs() < 0.02, "{doubled} vs {own}");
+    // Other features: the doubled image's finest octave is gone (on this cut, more of them pass the ratio test).
+    assert_ne!(own["matches"], doubled["matches"]);
+}
+
+#[test]
 fn rejected_merge_exits_2_and_writes_no_map() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();

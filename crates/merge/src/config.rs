@@ -30,6 +30,9 @@ pub struct MergerConfig {
     pub hypotheses: usize,
     /// Occupied cells grown by this many cells before SIFT.
     pub wall_dilation: usize,
+    /// SIFT doubles each map image before its pyramid (OpenCV's `firstOctave = -1`, Lowe's recommendation for
+    /// photographs); false starts at the map's own cells, for SLAM maps whose finest scale is the walls' jitter.
+    pub upscale: bool,
     /// Detect and match the two maps' features on two threads (one merge with the machine to itself).
     pub parallel: bool,
     /// A cascade runs `sift+boundary` beside `sift` ([`Cascade::side_by_side`]: for robots' maps, which `sift`
@@ -57,6 +60,7 @@ impl Default for MergerConfig {
             mutual: sift.matching.mutual,
             hypotheses: sift.hypotheses,
             wall_dilation: sift.wall_dilation,
+            upscale: sift.sift.upscale,
             parallel: sift.parallel,
             side_by_side: false,
             min_margin: correlative.answer.min_margin,
@@ -89,6 +93,7 @@ impl MergerConfig {
             ..SiftMergerParams::default()
         };
         p.ransac.seed = self.seed;
+        p.sift.upscale = self.upscale;
         p
     }
 

@@ -143,7 +143,12 @@ impl Merger for CorrelativeMerger {
         };
         let (forward, back) = match (p.answer.cross_check, p.parallel) {
             (false, _) => (self.answers(a, b, &mut timings), None),
-            (true, false) => (self.answers(a, b, &mut timings), Some(back())),
+            (true, false) => {
+                // One after the other, the check only for an answer to check (a refusal stands without it).
+                let forward = self.answers(a, b, &mut timings);
+                let back = forward.is_ok().then(back);
+                (forward, back)
+            }
             (true, true) => {
                 let (forward, back) = rayon::join(|| self.answers(a, b, &mut timings), back);
                 (forward, Some(back))

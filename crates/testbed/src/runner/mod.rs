@@ -38,6 +38,7 @@ pub fn merger_for(algorithm: Algorithm, scenario: &Scenario) -> MergerConfig {
         candidates: m.candidates,
         hypotheses: m.hypotheses,
         wall_dilation: m.wall_dilation,
+        upscale: m.upscale,
         ..MergerConfig::new(algorithm, scenario.seed)
     }
 }

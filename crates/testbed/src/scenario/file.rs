@@ -133,6 +133,7 @@ pub(super) struct MergeFile {
     pub(super) candidates: Option<usize>,
     pub(super) hypotheses: Option<usize>,
     pub(super) wall_dilation: Option<usize>,
+    pub(super) upscale: Option<bool>,
     pub(super) host: Option<String>,
 }
 

@@ -35,6 +35,8 @@ pub struct MergeSetup {
     pub hypotheses: usize,
     /// Cells by which walls grow before SIFT.
     pub wall_dilation: usize,
+    /// SIFT doubles each map image first (OpenCV's and Lowe's default).
+    pub upscale: bool,
     /// Robot that hosts the merge (the paper: Experia); the other's map is merged into its frame.
     pub host: String,
 }
@@ -93,5 +95,6 @@ pub(super) fn resolve_merge(
     let candidates = in_range("merge.candidates", m.candidates, 1, 16, 1)?;
     let hypotheses = in_range("merge.hypotheses", m.hypotheses, 1, 16, 1)?;
     let wall_dilation = in_range("merge.wall_dilation", m.wall_dilation, 0, 4, 0)?;
-    Ok(MergeSetup { when, algorithms, model, ratio, encoding, candidates, hypotheses, wall_dilation, host })
+    let upscale = m.upscale.unwrap_or(true);
+    Ok(MergeSetup { when, algorithms, model, ratio, encoding, candidates, hypotheses, wall_dilation, upscale, host })
 }

@@ -197,6 +197,18 @@ mod tests {
     }
 
     #[test]
+    fn sift_doubles_the_map_images_unless_the_merge_table_says_upscale_false() {
+        use crate::runner::merger_for;
+        let s = two_rooms(|t| t).unwrap();
+        assert!(s.merge.upscale && merger_for(Algorithm::Cascade, &s).sift().sift.upscale);
+        let s = two_rooms(|t| t.replace("wall_dilation = 1\n", "wall_dilation = 1\nupscale = false\n")).unwrap();
+        assert!(!s.merge.upscale && !merger_for(Algorithm::Cascade, &s).sift().sift.upscale);
+        let e = two_rooms(|t| t.replace("wall_dilation = 1\n", "wall_dilation = 1\nupscale = \"no\"\n")).unwrap_err();
+        assert_eq!(e.line, 18, "{e}");
+        assert!(e.message.contains("expected a boolean"), "{e}");
+    }
+
+    #[test]
     fn the_description_is_kept_and_may_be_left_out() {
         let s = two_rooms(|t| t).unwrap();
         assert_eq!(s.description.as_deref(), Some("two heterogeneous robots map two rooms and merge by the door"));
