@@ -147,18 +147,6 @@ impl ScoreField {
             0
         }
     }
-
-    /// The same field with `margin` zero cells on every side: cell (x, y) moves to (x + margin, y + margin).
-    pub fn with_margin(&self, margin: usize) -> ScoreField {
-        let width = self.width + 2 * margin;
-        let mut values = vec![0i16; width * (self.height + 2 * margin)];
-        if self.width > 0 {
-            for (row, out) in self.values.chunks_exact(self.width).zip(values.chunks_exact_mut(width).skip(margin)) {
-                out[margin..margin + self.width].copy_from_slice(row);
-            }
-        }
-        ScoreField { width, height: self.height + 2 * margin, values }
-    }
 }
 
 /// A square table of the blur, `2 radius + 1` cells a side.

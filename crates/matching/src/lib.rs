@@ -25,4 +25,4 @@ pub use information::Information;
 pub use local::{LocalScratch, LocalWindow, ScanPose, WindowField, WindowKey, local_search, window_key};
 pub use pyramid::{PooledGrid, Pyramid};
 pub use scan::WallScan;
-pub use search::{Best, Candidate, SearchScratch, Window, branch_and_bound};
+pub use search::{Best, Candidate, Window, branch_and_bound};

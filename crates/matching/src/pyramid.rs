@@ -27,27 +27,6 @@ impl PooledGrid {
         if sx < self.width && sy < self.height { self.values[(sy * self.width + sx) as usize] } else { 0 }
     }
 
-    /// The same sum with the points given also as index offsets in this level's rows (`offsets[i]` =
-    /// `y · width + x` of point i, [`PooledGrid::row_offsets`]) and their bounding box `[x0, x1, y0, y1]`:
-    /// when every displaced point lies on the stored grid, one load per point and no test.
-    #[inline]
-    pub fn score_laid_out(&self, points: &[(i32, i32)], offsets: &[i32], bbox: [i32; 4], ox: i32, oy: i32) -> i64 {
-        let (bx, by) = (ox + self.pad, oy + self.pad);
-        let (w, h) = (self.width as i32, self.height as i32);
-        if bbox[0] + bx < 0 || bbox[1] + bx >= w || bbox[2] + by < 0 || bbox[3] + by >= h {
-            return self.score(points, ox, oy);
-        }
-        // Every (x + bx, y + by) lies on the grid, so base + offset = (y + by) · w + x + bx is a stored index.
-        let base = by as isize * w as isize + bx as isize;
-        offsets.iter().map(|&o| i64::from(self.values[(base + o as isize) as usize])).sum()
-    }
-
-    /// Each point's index offset in this level's rows (`y · width + x`), into `out`.
-    pub fn row_offsets(&self, points: &[(i32, i32)], out: &mut Vec<i32>) {
-        out.clear();
-        out.extend(points.iter().map(|&(x, y)| y * self.width as i32 + x));
-    }
-
     /// Heap bytes of the values.
     pub fn bytes(&self) -> usize {
         self.values.capacity() * std::mem::size_of::<i16>()
@@ -155,35 +134,6 @@ mod tests {
                             assert!(s <= bound, "level {k} ({ox}, {oy}) + ({i}, {j}): {s} > {bound}");
                         }
                     }
-                }
-            }
-        }
-    }
-
-    #[test]
-    fn a_score_laid_out_is_the_score_on_and_off_the_grid_and_with_a_margin() {
-        let f = random_field(3);
-        let m = 9;
-        let padded = f.with_margin(m as usize);
-        for y in -3..f.height as i32 + 3 {
-            for x in -3..f.width as i32 + 3 {
-                assert_eq!(padded.get(x + m, y + m), f.get(x, y), "({x}, {y})");
-            }
-        }
-        let (p, q) = (Pyramid::build(&f, 3), Pyramid::build(&padded, 3));
-        let mut rng = ChaCha8Rng::seed_from_u64(8);
-        let points: Vec<(i32, i32)> = (0..40).map(|_| (rng.random_range(-4..9), rng.random_range(-3..7))).collect();
-        let bbox = [-4, 8, -3, 6];
-        let mut offsets = Vec::new();
-        for k in 0..=3 {
-            for oy in -15..30 {
-                for ox in -15..45 {
-                    let want = p.levels[k].score(&points, ox, oy);
-                    p.levels[k].row_offsets(&points, &mut offsets);
-                    assert_eq!(p.levels[k].score_laid_out(&points, &offsets, bbox, ox, oy), want, "{k} ({ox}, {oy})");
-                    q.levels[k].row_offsets(&points, &mut offsets);
-                    let shifted = q.levels[k].score_laid_out(&points, &offsets, bbox, ox + m, oy + m);
-                    assert_eq!(shifted, want, "level {k} ({ox}, {oy}) with a margin");
                 }
             }
         }

@@ -74,86 +74,52 @@ impl Best {
     }
 }
 
-/// Buffers of [`branch_and_bound`], kept between calls (no allocation once they have grown).
-#[derive(Debug, Default)]
-pub struct SearchScratch {
-    /// The root blocks.
-    roots: Vec<Candidate>,
-    /// The points as index offsets in each level's rows.
-    offsets: Vec<Vec<i32>>,
-}
-
-/// The points of one search: their cells, bounding box and index offsets per level.
-struct Laid<'a> {
-    points: &'a [(i32, i32)],
-    bbox: [i32; 4],
-    offsets: &'a [Vec<i32>],
-}
-
-impl Laid<'_> {
-    /// The score at (`ox`, `oy`) on level `k`.
-    #[inline]
-    fn score(&self, pyramid: &Pyramid, k: usize, ox: i32, oy: i32) -> i64 {
-        pyramid.levels[k].score_laid_out(self.points, &self.offsets[k], self.bbox, ox, oy)
-    }
-}
-
 /// Branch and bound of `points` over the offsets of `window` on `pyramid`: the best distinct offsets.
 ///
-/// `scratch` holds the root blocks and the points' layout between calls (no allocation once they have grown).
-/// A search whose points stay on the pyramid's grids at every offset of the window (a pyramid built with a
-/// margin, [`crate::ScoreField::with_margin`]) reads one value per point with no bounds test.
+/// `scratch` holds the root blocks between calls (no allocation once it has grown).
 pub fn branch_and_bound(
     pyramid: &Pyramid,
     points: &[(i32, i32)],
     window: Window,
     best: &mut Best,
-    scratch: &mut SearchScratch,
+    scratch: &mut Vec<Candidate>,
 ) {
     let depth = pyramid.depth();
     let step = 1i32 << depth;
-    let SearchScratch { roots, offsets } = scratch;
-    let mut bbox = [i32::MAX, i32::MIN, i32::MAX, i32::MIN];
-    for &(x, y) in points {
-        bbox = [bbox[0].min(x), bbox[1].max(x), bbox[2].min(y), bbox[3].max(y)];
-    }
-    offsets.resize_with(depth + 1, Vec::new);
-    for (level, out) in pyramid.levels.iter().zip(offsets.iter_mut()) {
-        level.row_offsets(points, out);
-    }
-    let laid = Laid { points, bbox, offsets };
-    roots.clear();
+    scratch.clear();
+    let top = &pyramid.levels[depth];
     let mut oy = window.y0;
     while oy <= window.y1 {
         let mut ox = window.x0;
         while ox <= window.x1 {
-            roots.push(Candidate { score: laid.score(pyramid, depth, ox, oy), ox, oy });
+            scratch.push(Candidate { score: top.score(points, ox, oy), ox, oy });
             ox += step;
         }
         oy += step;
     }
-    roots.sort_unstable_by(|a, b| b.score.cmp(&a.score).then(a.oy.cmp(&b.oy)).then(a.ox.cmp(&b.ox)));
-    for &c in roots.iter() {
+    scratch.sort_unstable_by(|a, b| b.score.cmp(&a.score).then(a.oy.cmp(&b.oy)).then(a.ox.cmp(&b.ox)));
+    for &c in scratch.iter() {
         if best.prunes(c.score) {
             break;
         }
-        descend(pyramid, &laid, window, depth, c, best);
+        descend(pyramid, points, window, depth, c, best);
     }
 }
 
 /// Splits block `c` of level `k` (k ≥ 1) into its four children, best first; offers leaves.
-fn descend(pyramid: &Pyramid, laid: &Laid, window: Window, k: usize, c: Candidate, best: &mut Best) {
+fn descend(pyramid: &Pyramid, points: &[(i32, i32)], window: Window, k: usize, c: Candidate, best: &mut Best) {
     if k == 0 {
         best.offer(c);
         return;
     }
     let half = 1i32 << (k - 1);
+    let level = &pyramid.levels[k - 1];
     let mut children = [Candidate { score: i64::MIN, ox: 0, oy: 0 }; 4];
     let mut n = 0;
     for (dx, dy) in [(0, 0), (half, 0), (0, half), (half, half)] {
         let (ox, oy) = (c.ox + dx, c.oy + dy);
         if ox <= window.x1 && oy <= window.y1 {
-            children[n] = Candidate { score: laid.score(pyramid, k - 1, ox, oy), ox, oy };
+            children[n] = Candidate { score: level.score(points, ox, oy), ox, oy };
             n += 1;
         }
     }
@@ -163,7 +129,7 @@ fn descend(pyramid: &Pyramid, laid: &Laid, window: Window, k: usize, c: Candidat
         if best.prunes(child.score) {
             break;
         }
-        descend(pyramid, laid, window, k - 1, child, best);
+        descend(pyramid, points, window, k - 1, child, best);
     }
 }
 
@@ -195,7 +161,7 @@ mod tests {
             }
             let pyramid = Pyramid::build(&field, 1 + trial % 5);
             let mut best = Best::new(3, 3, i64::MIN);
-            branch_and_bound(&pyramid, &points, window, &mut best, &mut SearchScratch::default());
+            branch_and_bound(&pyramid, &points, window, &mut best, &mut Vec::new());
             assert_eq!(best.found[0].score, exhaustive.score, "trial {trial}");
             assert!(best.found.windows(2).all(|p| p[0].score >= p[1].score));
             for (i, c) in best.found.iter().enumerate() {

@@ -9,8 +9,8 @@ use crate::alignment::NoAlignment;
 use crate::timing::ms;
 use mrslam_core::{OccupancyGrid, Pose2};
 use mrslam_matching::{
-    Best, BlockStates, Candidate, HIT, LocalScratch, LocalWindow, Pyramid, ScanPose, ScoreField, SearchScratch,
-    WallScan, Window, WindowField, branch_and_bound, local_search,
+    Best, BlockStates, Candidate, HIT, LocalScratch, LocalWindow, Pyramid, ScanPose, ScoreField, WallScan, Window,
+    WindowField, branch_and_bound, local_search,
 };
 use std::collections::BTreeMap;
 use std::f64::consts::{PI, TAU};
@@ -102,10 +102,7 @@ impl CorrelativeMerger {
         if !field.values.contains(&HIT) {
             return Err(fail("map a has no walls".into(), timings.clone()));
         }
-        // The field with zero cells around it as wide as b's scan, which then stays on the pyramid's grids at
-        // every offset searched: scored with no bounds tests (the same scores, offsets shifted by `m`).
-        let m = (2.0 * scan.radius / cell).ceil() as i32 + 2;
-        let pyramid = Pyramid::build(&field.with_margin(m as usize), p.search.depth);
+        let pyramid = Pyramid::build(&field, p.search.depth);
         timings.insert("field".into(), ms(t));
         let t = Instant::now();
         let step = (p.search.angle_step_scale * cell / scan.radius.max(cell)).min(PI / 2.0);
@@ -115,7 +112,7 @@ impl CorrelativeMerger {
         let searched = |j: usize| peaks.is_empty() || orientation::near_a_peak(j as f64 * step, peaks, tolerance);
         let min_floor = (p.search.min_score * f64::from(HIT) * scan.points.len() as f64).ceil() as i64;
         let separation = ((p.search.distinct_m / cell).ceil() as i32).max(1);
-        let one = |scratch: &mut (Vec<(i32, i32)>, SearchScratch), j: usize, floor: i64| -> Vec<Global> {
+        let one = |scratch: &mut (Vec<(i32, i32)>, Vec<Candidate>), j: usize, floor: i64| -> Vec<Global> {
             let (points, roots) = scratch;
             scan.discretize(j as f64 * step, cell, points);
             let (mut x0, mut x1, mut y0, mut y1) = (i32::MAX, i32::MIN, i32::MAX, i32::MIN);
@@ -137,10 +134,8 @@ impl CorrelativeMerger {
                 }
             }
             let mut best = Best::new(p.search.per_rotation, separation, floor);
-            let padded = Window { x0: window.x0 + m, x1: window.x1 + m, y0: window.y0 + m, y1: window.y1 + m };
-            branch_and_bound(&pyramid, points, padded, &mut best, roots);
-            let unpad = |c: &Candidate| Candidate { ox: c.ox - m, oy: c.oy - m, ..*c };
-            best.found.iter().map(|c| Global { rotation: j, candidate: unpad(c) }).collect()
+            branch_and_bound(&pyramid, points, window, &mut best, roots);
+            best.found.iter().map(|&candidate| Global { rotation: j, candidate }).collect()
         };
         // Rotations in rounds of halving stride (every 16th, then the 8th between them, ...): the best score
         // of the rounds so far sets the floor of the next (keep_ratio of it), so later rounds prune harder.

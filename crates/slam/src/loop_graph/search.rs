@@ -7,7 +7,7 @@ use crate::loop_closure::{LOOP_HUBER, LoopClosureParams, loop_information};
 use crate::scan_matcher::{PreparedScan, ScanMatcher, Scratch};
 use mrslam_core::Xyt;
 use mrslam_matching::pose_graph::Edge;
-use mrslam_matching::{Best, HIT, SearchScratch, Window, branch_and_bound};
+use mrslam_matching::{Best, HIT, Window, branch_and_bound};
 use rayon::prelude::*;
 
 /// Where a scan is searched for: within ± `linear` metres and ± `angular` radians of a predicted pose.
@@ -92,7 +92,7 @@ pub fn branch_and_bound_pose(
         headings
             .par_iter()
             .map_init(
-                || (Vec::new(), SearchScratch::default()),
+                || (Vec::new(), Vec::new()),
                 |(cells, scratch), &k| {
                     let theta = predicted.theta + k as f64 * step;
                     let (s, c) = theta.sin_cos();
