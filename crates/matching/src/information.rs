@@ -12,6 +12,12 @@ impl Information {
     /// No information at all.
     pub const ZERO: Information = Information([0.0; 6]);
 
+    /// Independent errors: `sigma` metres along x and along y, `heading_sigma` radians in θ.
+    pub fn from_sigmas(sigma: f64, heading_sigma: f64) -> Self {
+        let (i, h) = (1.0 / (sigma * sigma), 1.0 / (heading_sigma * heading_sigma));
+        Information([i, 0.0, 0.0, i, 0.0, h])
+    }
+
     /// The upper triangle of the symmetric matrix `m`.
     pub fn from_matrix(m: &Matrix3<f64>) -> Self {
         Information([m[(0, 0)], m[(0, 1)], m[(0, 2)], m[(1, 1)], m[(1, 2)], m[(2, 2)]])

@@ -214,14 +214,7 @@ pub fn close_loops(
     if loops.is_empty() {
         return (poses, report);
     }
-    let chain_info = Information([
-        1.0 / (params.chain_sigma * params.chain_sigma),
-        0.0,
-        0.0,
-        1.0 / (params.chain_sigma * params.chain_sigma),
-        0.0,
-        1.0 / (params.chain_heading_sigma * params.chain_heading_sigma),
-    ]);
+    let chain_info = Information::from_sigmas(params.chain_sigma, params.chain_heading_sigma);
     let mut edges: Vec<Edge> = (1..nodes.len())
         .map(|k| Edge {
             from: k - 1,

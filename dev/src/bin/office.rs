@@ -254,7 +254,7 @@ fn oracle(traj: &[(f64, Pose2)], truth: &[(f64, Pose2)], spec: &str) {
             from: k - 1,
             to: k,
             measured: Xyt::from_pose(&relative(&traj[k - 1].1, &traj[k].1)),
-            information: Information([1.0 / (v[0] * v[0]), 0.0, 0.0, 1.0 / (v[0] * v[0]), 0.0, 1.0 / (v[1] * v[1])]),
+            information: Information::from_sigmas(v[0], v[1]),
             huber: f64::INFINITY,
         });
     }
@@ -274,14 +274,7 @@ fn oracle(traj: &[(f64, Pose2)], truth: &[(f64, Pose2)], spec: &str) {
                 from: j,
                 to: k,
                 measured: Xyt::from_pose(&relative(&tr[j], &tr[k])),
-                information: Information([
-                    1.0 / (lc.sigma * lc.sigma),
-                    0.0,
-                    0.0,
-                    1.0 / (lc.sigma * lc.sigma),
-                    0.0,
-                    1.0 / (lc.heading_sigma * lc.heading_sigma),
-                ]),
+                information: Information::from_sigmas(lc.sigma, lc.heading_sigma),
                 huber: f64::INFINITY,
             });
         }

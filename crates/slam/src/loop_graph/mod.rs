@@ -220,8 +220,7 @@ impl LoopGraph {
     }
 
     fn chain_information(&self) -> Information {
-        let (t, r) = (self.params.chain_sigma, self.params.chain_heading_sigma);
-        Information([1.0 / (t * t), 0.0, 0.0, 1.0 / (t * t), 0.0, 1.0 / (r * r)])
+        Information::from_sigmas(self.params.chain_sigma, self.params.chain_heading_sigma)
     }
 
     /// The search window for a place `driven` metres from the newest node through the graph.
