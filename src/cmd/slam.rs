@@ -400,6 +400,14 @@ pub fn run(args: SlamArgs) -> Result<ExitCode> {
                 l.open_loops
             );
         }
+        if l.contradicts_itself() {
+            println!(
+                "warning: {} of {} scans of places passed a loop ago see walls where the map has open floor: the \
+                 map puts places on top of each other (loops closed into a wrong building, or a turn the odometry \
+                 missed)",
+                l.contradicted, l.judged
+            );
+        }
     }
     if filter.params().filter.odometry_calibration > 0.0 {
         let [scale, heading] = filter.odometry_calibration();
@@ -470,6 +478,9 @@ pub fn run(args: SlamArgs) -> Result<ExitCode> {
                 "dropped": l.dropped,
                 "optimisations": l.optimisations,
                 "open_loops": l.open_loops,
+                "judged": l.judged,
+                "contradicted": l.contradicted,
+                "contradicts_itself": l.contradicts_itself(),
                 "max_correction_m": l.max_correction,
                 "iterations": l.iterations,
                 "reanchors": c.reanchors,
@@ -501,8 +512,16 @@ fn describe_loops(l: &mrslam_slam::LoopClosureReport, online: bool, processed: u
         format!(
             "{} searches of {processed} processed scans against places passed a loop ago: {} loop edges kept, {} \
              found nothing, {} dropped as inconsistent; {} optimisations moved a scan by at most {:.2} m; {} loops \
-             left open",
-            l.candidates, l.closures, l.rejected, l.dropped, l.optimisations, l.max_correction, l.open_loops
+             left open; {} of {} scans judged against the map a loop apart contradict it",
+            l.candidates,
+            l.closures,
+            l.rejected,
+            l.dropped,
+            l.optimisations,
+            l.max_correction,
+            l.open_loops,
+            l.contradicted,
+            l.judged
         )
     } else {
         format!(
@@ -526,7 +545,8 @@ fn record_the_end(
     let last = scans.len() - 1;
     v.set_time(last as u64, scans[last].scan.stamp - stamp0);
     if let Some(l) = &run.loop_closure {
-        let level = if l.closures > 0 && l.open_loops == 0 { Level::Info } else { Level::Warn };
+        let level =
+            if l.closures > 0 && l.open_loops == 0 && !l.contradicts_itself() { Level::Info } else { Level::Warn };
         let text =
             format!("loop closure: {}", describe_loops(l, filter.params().loop_closure.online, run.processed.len()));
         v.event(level, &text);

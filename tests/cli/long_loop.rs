@@ -136,6 +136,7 @@ fn the_aces_loop_is_closed(seed: u64) {
     }
     let report = report.unwrap();
     assert_eq!(report.open_loops, 0, "seed {seed}: {report:?}");
+    assert!(report.judged > 0 && !report.contradicts_itself(), "seed {seed}: {report:?}");
 }
 
 #[test]

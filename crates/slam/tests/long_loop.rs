@@ -104,7 +104,7 @@ fn a_200_m_loop_is_closed_on_every_seed_while_driving() {
     let mut failed = Vec::new();
     for o in outcomes() {
         let seed = o.seed;
-        if !(o.report.closures >= 5 && o.report.open_loops == 0) {
+        if !(o.report.closures >= 5 && o.report.open_loops == 0 && !o.report.contradicts_itself()) {
             failed.push(format!("seed {seed}: {:?}", o.report));
         }
         if o.back >= 0.3 {

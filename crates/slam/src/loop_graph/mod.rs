@@ -14,7 +14,13 @@
 //! Mahalanobis distance above `max_residual` once optimised) are dropped, worst first. The filter is then
 //! re-anchored on the graph (see [`crate::Rbpf`]): its map is redrawn from the optimised poses, so the map it
 //! matches against, and the one it outputs, are loop-closed at every moment.
+//!
+//! At the end of the data the map is judged ([`free_space`]): every node against the submaps near it that it is a
+//! loop's driving away from, counting the scans that see walls on a submap's open floor. A loop the search could
+//! not reach leaves such scans wherever the map puts a place beside or across itself, which the count of loops
+//! left open does not see when no revisit is long enough ([`crate::LoopClosureReport::contradicts_itself`]).
 
+mod free_space;
 mod search;
 mod submap;
 
@@ -22,6 +28,7 @@ use crate::loop_closure::{LoopClosureParams, LoopClosureReport};
 use crate::map_build::MapParams;
 use crate::particle::TrajectoryNode;
 use crate::scan_matcher::{MatcherParams, PreparedScan, ScanMatcher};
+use free_space::FreeSpace;
 use mrslam_core::{LaserScan, Xyt};
 use mrslam_matching::Information;
 use mrslam_matching::pose_graph::{Edge, optimize};
@@ -51,6 +58,13 @@ const CONSISTENT_RAD: f64 = 0.03;
 /// The drift rates the windows allow grow to at most this many times `window_per_metre` and
 /// `heading_window_per_metre`.
 const MAX_DRIFT_GROWTH: f64 = 4.0;
+
+/// Points of a scan that must fall where a submap saw something for the scan to be judged against it.
+const MIN_SEEN: usize = 30;
+/// Share of those on the submap's open floor, beyond the window's reach of its walls, that contradicts it.
+const CONTRADICTING_SHARE: f64 = 0.15;
+/// How far a scan may be from where the graph puts it in a good map when its map is judged.
+const JUDGE_WINDOW: SearchWindow = SearchWindow { linear: 0.5, angular: 0.01 };
 
 /// The online pose graph: nodes, chain and loop edges, submaps, and what its searches did.
 #[derive(Debug, Clone)]
@@ -197,6 +211,7 @@ impl LoopGraph {
     pub fn finish(&mut self) -> bool {
         let moved = self.pending > 0 && self.optimise(FINAL_ITERATIONS);
         self.end_revisit();
+        self.judge_map();
         moved
     }
 
@@ -317,6 +332,56 @@ impl LoopGraph {
         }
         let edge = refine_to_edge(&grids, &self.matcher, scan, &found, &self.params, (s.first, k))?;
         Some(self.held_from_nearest_node(edge, s))
+    }
+
+    /// Judges the map the graph holds: every node against the submaps near it that it is at least a loop's
+    /// driving away from ([`free_space`]); counts the nodes whose scan sees surfaces on a submap's open floor.
+    fn judge_map(&mut self) {
+        let cell = self.map.delta * submap::COARSE as f64;
+        // The submaps each node is judged against, as (submap, node) pairs by submap: one free-space grid at a time.
+        let mut pairs: Vec<(usize, usize)> = Vec::new();
+        for (k, node) in self.nodes.iter().enumerate() {
+            let mut near: Vec<(f64, usize)> = Vec::new();
+            for (i, s) in self.submaps.iter().enumerate() {
+                let apart =
+                    (self.travel[k] - self.travel[s.last]).abs().min((self.travel[k] - self.travel[s.first]).abs());
+                if (s.first..=s.last).contains(&k) || apart < self.params.min_travel {
+                    continue;
+                }
+                let d = (s.first..=s.last)
+                    .map(|n| (self.nodes[n].pose.x - node.pose.x).hypot(self.nodes[n].pose.y - node.pose.y))
+                    .fold(f64::INFINITY, f64::min);
+                if d <= self.params.search_radius {
+                    near.push((d, i));
+                }
+            }
+            near.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+            pairs.extend(near.iter().take(self.params.max_searches).map(|&(_, i)| (i, k)));
+        }
+        pairs.sort_unstable();
+        // Each judged node's most contradicted judgement: (contradicting, seen).
+        let mut worst: Vec<Option<(usize, usize)>> = vec![None; self.nodes.len()];
+        for group in pairs.chunk_by(|a, b| a.0 == b.0) {
+            let s = self.submaps[group[0].0];
+            let anchor = self.nodes[s.first].pose;
+            let poses: Vec<Xyt> = (s.first..=s.last).map(|n| self.nodes[n].pose).collect();
+            let prepared: Vec<PreparedScan> = (s.first..=s.last).map(|n| self.prepare(&self.nodes[n].scan)).collect();
+            let scans: Vec<(Xyt, &PreparedScan)> =
+                in_anchor_frame(&anchor, &poses).into_iter().zip(&prepared).collect();
+            let Some(space) = FreeSpace::build(&scans, &self.matcher, cell) else { continue };
+            for &(_, k) in group {
+                let scan = self.prepare(&self.nodes[k].scan);
+                let at = in_anchor_frame(&anchor, &[self.nodes[k].pose])[0];
+                let j = space.judge(&search_points(&scan, &self.matcher, cell), &at, JUDGE_WINDOW);
+                let w = &mut worst[k];
+                if j.seen >= MIN_SEEN && w.is_none_or(|(c, n)| j.contradicting * n > c * j.seen) {
+                    *w = Some((j.contradicting, j.seen));
+                }
+            }
+        }
+        let judged: Vec<(usize, usize)> = worst.into_iter().flatten().collect();
+        self.report.judged = judged.len();
+        self.report.contradicted = judged.iter().filter(|&&(c, n)| c as f64 >= CONTRADICTING_SHARE * n as f64).count();
     }
 
     /// The loop edge `edge` (submap `s`'s first node → the scan's node, measured in the submap's frame) re-expressed
@@ -484,6 +549,15 @@ mod tests {
     /// Feeds the graph the office lap's true increments with a heading bias of `bias` rad per node; returns the
     /// poses it holds after each node and its report.
     fn drive(bias: f64, params: LoopClosureParams) -> (Vec<mrslam_core::Pose2>, Vec<Vec<Xyt>>, LoopClosureReport) {
+        drive_turning(|k| if k > 0 { bias } else { 0.0 }, params)
+    }
+
+    /// Feeds the graph the office lap's true increments, node `k`'s turned by `turn(k)` rad more; returns the poses
+    /// it holds after each node and its report.
+    fn drive_turning(
+        turn: impl Fn(usize) -> f64,
+        params: LoopClosureParams,
+    ) -> (Vec<mrslam_core::Pose2>, Vec<Vec<Xyt>>, LoopClosureReport) {
         let (truth, scans, laser) = office_nodes();
         let p = crate::SlamParams::matched();
         let map = MapParams { max_range: 30.0, max_urange: 30.0, ..p.map };
@@ -492,9 +566,7 @@ mod tests {
         for k in 0..truth.len() {
             let mut z =
                 if k == 0 { Xyt::from_pose(&truth[0]) } else { Xyt::from_pose(&relative(&truth[k - 1], &truth[k])) };
-            if k > 0 {
-                z.theta += bias;
-            }
+            z.theta += turn(k);
             graph.add(k as f64, z, scans[k].clone());
             history.push(graph.nodes().iter().map(|n| n.pose).collect());
         }
@@ -576,5 +648,25 @@ mod tests {
         assert_eq!(report.dropped, 0, "{report:?}");
         let (worst, _) = error_to(&truth, history.last().unwrap());
         assert!(worst < 0.03, "the graph moved a true pose {worst} m");
+        assert!(report.judged >= 5 && report.contradicted == 0, "{report:?}");
+    }
+
+    /// Where the kinked lap turns wrong (quarters of the lap) and by how much, radians.
+    const KINK_AT: usize = 3;
+    const KINK: f64 = 0.2;
+
+    #[test]
+    fn a_lap_kinked_beyond_what_its_loop_search_reaches_is_judged_contradicted() {
+        let (truth, _, _) = office_nodes();
+        let at = KINK_AT * truth.len() / 4;
+        let kink = |size: f64| move |k: usize| if k == at { size } else { 0.0 };
+        // No loop edge is kept (no match scores 1): the lap's end lies where the increments put it.
+        let params = LoopClosureParams { min_score: 1.0, ..crate::SlamParams::matched().loop_closure };
+        let (_, _, straight) = drive_turning(kink(0.0), params);
+        assert!(straight.judged >= 5 && straight.contradicted == 0, "{straight:?}");
+        let (truth, history, kinked) = drive_turning(kink(KINK), params);
+        let (worst, _) = error_to(&truth, history.last().unwrap());
+        assert!(worst > 1.0, "the kink must move the lap's end: {worst} m");
+        assert!(kinked.judged >= 5 && kinked.contradicted * 2 >= kinked.judged, "{kinked:?}");
     }
 }
