@@ -478,6 +478,8 @@ pub fn run(args: SlamArgs) -> Result<ExitCode> {
                 "dropped": l.dropped,
                 "optimisations": l.optimisations,
                 "open_loops": l.open_loops,
+                "relocalisations": l.relocalisations,
+                "relocalised": l.relocalised,
                 "judged": l.judged,
                 "contradicted": l.contradicted,
                 "contradicts_itself": l.contradicts_itself(),

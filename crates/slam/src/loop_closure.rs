@@ -99,6 +99,11 @@ pub struct LoopClosureParams {
     /// `loop_open_travel`, metres: driving this far through places passed a loop ago without a loop edge is a
     /// loop left open (counted in the report).
     pub open_loop_travel: f64,
+    /// `loop_relocalise` (online only): when scans of places passed a loop ago keep seeing walls on the map's open
+    /// floor where the graph puts them, the graph is wrong beyond what its windows reach (a turn the odometry
+    /// missed in a gap of the data); the scans are then searched against every submap, over the whole submap and
+    /// every heading, and an answer that agrees from node to node becomes a loop edge. Off: the windows only.
+    pub relocalise: bool,
 }
 
 impl Default for LoopClosureParams {
@@ -128,6 +133,7 @@ impl Default for LoopClosureParams {
             optimize_every: 10,
             max_residual: 10.0,
             open_loop_travel: 10.0,
+            relocalise: true,
         }
     }
 }
@@ -148,6 +154,11 @@ pub struct LoopClosureReport {
     /// Stretches of at least `loop_open_travel` metres through places passed a loop ago in which no loop edge
     /// was found (online only): a map with such a stretch may show a place twice.
     pub open_loops: usize,
+    /// Searches of a scan against every submap over every heading, made after scans contradicted the map where
+    /// the graph put them (online only).
+    pub relocalisations: usize,
+    /// Loop edges those searches kept (also counted in `closures`).
+    pub relocalised: usize,
     /// Processed scans judged at the end against the submaps near them passed a loop apart (online only).
     pub judged: usize,
     /// Of those, the scans that see surfaces on a submap's open floor, where the map holds no wall (online only):

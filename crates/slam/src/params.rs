@@ -183,6 +183,7 @@ pub const FLAT_NAMES: &[(&str, &str)] = &[
     ("loop_optimize_every", "loop_closure.optimize_every"),
     ("loop_max_residual", "loop_closure.max_residual"),
     ("loop_open_travel", "loop_closure.open_loop_travel"),
+    ("loop_relocalise", "loop_closure.relocalise"),
 ];
 
 impl SlamParams {

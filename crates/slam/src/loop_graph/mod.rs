@@ -32,7 +32,7 @@ use free_space::FreeSpace;
 use mrslam_core::{LaserScan, Xyt};
 use mrslam_matching::Information;
 use mrslam_matching::pose_graph::{Edge, optimize};
-use search::{SearchWindow, branch_and_bound_pose, refine_to_edge, search_points};
+use search::{MAX_HEADING_STEPS, SearchWindow, branch_and_bound_pose, refine_to_edge, search_points};
 use std::sync::Arc;
 use submap::{GridCache, Submap, SubmapGrids, in_anchor_frame};
 
@@ -63,6 +63,17 @@ const MAX_DRIFT_GROWTH: f64 = 4.0;
 const MIN_SEEN: usize = 30;
 /// Share of those on the submap's open floor, beyond the window's reach of its walls, that contradicts it.
 const CONTRADICTING_SHARE: f64 = 0.15;
+/// Contradicted nodes that start a search against every submap ([`LoopGraph::relocalise`]).
+const RELOCALISE_AFTER: usize = 4;
+/// Metres of driving within which the contradicted nodes must lie.
+const RELOCALISE_TRAVEL: f64 = 10.0;
+/// Metres of driving after which nodes are no longer searched everywhere when none was placed.
+const RELOCALISE_GIVE_UP: f64 = 20.0;
+/// How closely two answers of searches everywhere must move the graph alike, metres and radians.
+const RELOCALISE_AGREE_M: f64 = 0.3;
+const RELOCALISE_AGREE_RAD: f64 = 0.05;
+/// Headings on each side of the predicted one a search against a whole submap tries at most (every turn).
+const RELOCALISE_HEADING_STEPS: usize = 1000;
 /// How far a scan may be from where the graph puts it in a good map when its map is judged.
 const JUDGE_WINDOW: SearchWindow = SearchWindow { linear: 0.5, angular: 0.01 };
 
@@ -101,6 +112,16 @@ pub struct LoopGraph {
     revisit: Option<(f64, bool)>,
     /// Answers the rival check refused lately: submap, the move they make of the node (its frame), travel at it.
     rivalled: Vec<(usize, Xyt, f64)>,
+    /// Travel at the nodes judged contradicted lately, with no loop edge since ([`LoopGraph::judge_revisit`]).
+    contradicted: Vec<f64>,
+    /// Travel at which the graph was found wrong beyond its windows, while its nodes are searched everywhere.
+    lost: Option<f64>,
+    /// A search everywhere kept a loop edge at the node being added.
+    relocalised_now: bool,
+    /// Those searches lately: travel, the node's pose in the graph then, where each answer put it (map frame).
+    relocalising: Vec<(f64, mrslam_core::Pose2, Vec<mrslam_core::Pose2>)>,
+    /// The free space of the submap last judged while driving: its index, the graph's version and the grid.
+    free_space: Option<(usize, u64, Arc<FreeSpace>)>,
     report: LoopClosureReport,
 }
 
@@ -129,6 +150,11 @@ impl LoopGraph {
             reach: Vec::new(),
             revisit: None,
             rivalled: Vec::new(),
+            contradicted: Vec::new(),
+            lost: None,
+            relocalised_now: false,
+            relocalising: Vec::new(),
+            free_space: None,
             report: LoopClosureReport::default(),
         }
     }
@@ -200,8 +226,13 @@ impl LoopGraph {
         }
         self.search(k);
         self.since_optimised += 1;
-        let redraw =
-            self.pending > 0 && self.since_optimised >= self.params.optimize_every && self.optimise(ONLINE_ITERATIONS);
+        // A node placed by a search everywhere moves much of the graph: optimised at once, to convergence.
+        let (due, iterations) = match self.relocalised_now {
+            true => (true, FINAL_ITERATIONS),
+            false => (self.since_optimised >= self.params.optimize_every, ONLINE_ITERATIONS),
+        };
+        self.relocalised_now = false;
+        let redraw = self.pending > 0 && due && self.optimise(iterations);
         // Nobody has seen the new node's pose before the optimisation: it is not reported as moved.
         self.reported[k] = self.nodes[k].pose;
         redraw
@@ -285,6 +316,15 @@ impl LoopGraph {
                         None => self.report.rejected += 1,
                     }
                 }
+                if !closed && near[0].0 <= self.params.search_radius {
+                    self.judge_revisit(k, near[0].1, &scan);
+                }
+            }
+        }
+        if self.lost.is_some() {
+            let scan = self.prepare(&self.nodes[k].scan);
+            if scan.matched.len() >= 10 {
+                closed |= self.relocalise(k, &scan);
             }
         }
         if closed {
@@ -311,27 +351,168 @@ impl LoopGraph {
     fn match_submap(&mut self, i: usize, k: usize, scan: &PreparedScan, window: SearchWindow) -> Option<Edge> {
         let s = self.submaps[i];
         let anchor = self.nodes[s.first].pose;
-        let grids = match self.cache.get(i, self.version) {
-            Some(g) => g,
-            None => {
-                let poses: Vec<Xyt> = (s.first..=s.last).map(|n| self.nodes[n].pose).collect();
-                let local = in_anchor_frame(&anchor, &poses);
-                let prepared: Vec<PreparedScan> =
-                    (s.first..=s.last).map(|n| self.prepare(&self.nodes[n].scan)).collect();
-                let scans: Vec<(Xyt, &PreparedScan)> = local.into_iter().zip(&prepared).collect();
-                let g = Arc::new(SubmapGrids::build(&scans, &self.matcher, self.map.delta, PYRAMID_DEPTH)?);
-                self.cache.put(i, self.version, g.clone());
-                g
-            }
-        };
+        let grids = self.grids(i)?;
         let predicted = in_anchor_frame(&anchor, &[self.nodes[k].pose])[0];
         let points = search_points(scan, &self.matcher, grids.cell);
-        let found = branch_and_bound_pose(&grids, &points, &predicted, window, self.params.min_score)?;
+        let found =
+            branch_and_bound_pose(&grids, &points, &predicted, window, self.params.min_score, MAX_HEADING_STEPS)?;
         if found.rival >= self.params.max_rival && !self.agrees_with_rivalled(i, k, &predicted, &found.pose) {
             return None;
         }
         let edge = refine_to_edge(&grids, &self.matcher, scan, &found, &self.params, (s.first, k))?;
         Some(self.held_from_nearest_node(edge, s))
+    }
+
+    /// Submap `i`'s free space, drawn from its nodes' poses now, in its anchor's frame.
+    fn free_space_of(&self, i: usize) -> Option<FreeSpace> {
+        let s = self.submaps[i];
+        let anchor = self.nodes[s.first].pose;
+        let poses: Vec<Xyt> = (s.first..=s.last).map(|n| self.nodes[n].pose).collect();
+        let prepared: Vec<PreparedScan> = (s.first..=s.last).map(|n| self.prepare(&self.nodes[n].scan)).collect();
+        let scans: Vec<(Xyt, &PreparedScan)> = in_anchor_frame(&anchor, &poses).into_iter().zip(&prepared).collect();
+        FreeSpace::build(&scans, &self.matcher, self.map.delta * submap::COARSE as f64)
+    }
+
+    /// Judges node `k`, whose searches found no loop edge, against submap `i` beside it. After
+    /// [`RELOCALISE_AFTER`] contradicted nodes within [`RELOCALISE_TRAVEL`] metres of driving with no loop edge, the
+    /// graph is wrong beyond what its windows reach: the node is searched against every submap passed a loop ago
+    /// ([`LoopGraph::relocalise`]), and so is every node after it until one is placed or [`RELOCALISE_GIVE_UP`]
+    /// metres have been driven.
+    fn judge_revisit(&mut self, k: usize, i: usize, scan: &PreparedScan) {
+        let space = match &self.free_space {
+            Some((j, v, f)) if *j == i && *v == self.version => f.clone(),
+            _ => {
+                let Some(f) = self.free_space_of(i) else { return };
+                let f = Arc::new(f);
+                self.free_space = Some((i, self.version, f.clone()));
+                f
+            }
+        };
+        let anchor = self.nodes[self.submaps[i].first].pose;
+        let at = in_anchor_frame(&anchor, &[self.nodes[k].pose])[0];
+        let cell = self.map.delta * submap::COARSE as f64;
+        let j = space.judge(&search_points(scan, &self.matcher, cell), &at, JUDGE_WINDOW);
+        if !(j.seen >= MIN_SEEN && j.contradicting as f64 >= CONTRADICTING_SHARE * j.seen as f64) {
+            return;
+        }
+        let travel = self.travel[k];
+        self.contradicted.retain(|&t| travel - t <= RELOCALISE_TRAVEL);
+        self.contradicted.push(travel);
+        if self.contradicted.len() < RELOCALISE_AFTER || !self.params.relocalise {
+            return;
+        }
+        self.contradicted.clear();
+        self.lost.get_or_insert(travel);
+    }
+
+    /// Searches node `k` against every finished submap passed a loop ago, over the whole submap and every heading.
+    /// An answer is kept as a loop edge when the answers of earlier such searches, at least
+    /// [`CONSISTENT_RIVALLED`] - 1 of them over [`CONSISTENT_TRAVEL`] metres of driving, move the graph alike (a scan
+    /// along a corridor matches many places of it; the true one agrees from node to node). Returns whether one was
+    /// kept.
+    fn relocalise(&mut self, k: usize, scan: &PreparedScan) -> bool {
+        self.report.relocalisations += 1;
+        let travel = self.travel[k];
+        let node = self.nodes[k].pose.to_pose();
+        // Every submap's best answer: where it puts the node (map frame), its score, the submap and the answer.
+        let mut answers: Vec<(mrslam_core::Pose2, f64, usize, search::Found)> = Vec::new();
+        for i in 0..self.submaps.len() {
+            let s = self.submaps[i];
+            if travel - self.travel[s.last] < self.params.min_travel {
+                continue;
+            }
+            let Some(grids) = self.grids(i) else { continue };
+            let anchor = self.nodes[s.first].pose;
+            let local = in_anchor_frame(&anchor, &(s.first..=s.last).map(|n| self.nodes[n].pose).collect::<Vec<_>>());
+            let (x0, x1) = local.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| (a.min(p.x), b.max(p.x)));
+            let (y0, y1) = local.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| (a.min(p.y), b.max(p.y)));
+            let predicted = in_anchor_frame(&anchor, &[self.nodes[k].pose])[0];
+            let centre = Xyt { x: 0.5 * (x0 + x1), y: 0.5 * (y0 + y1), theta: predicted.theta };
+            let window = SearchWindow {
+                linear: 0.5 * (x1 - x0).hypot(y1 - y0) + self.params.search_radius,
+                angular: std::f64::consts::PI,
+            };
+            let points = search_points(scan, &self.matcher, grids.cell);
+            let steps = RELOCALISE_HEADING_STEPS;
+            let Some(found) = branch_and_bound_pose(&grids, &points, &centre, window, self.params.min_score, steps)
+            else {
+                continue;
+            };
+            // An answer within the loop search's own window is one that search refused: only the places beyond it
+            // are new.
+            let usual = self.window((s.first..=s.last).map(|n| self.reach[n]).fold(f64::INFINITY, f64::min));
+            let beyond = (found.pose.x - predicted.x).hypot(found.pose.y - predicted.y) > usual.linear
+                || mrslam_core::pose::normalize_angle(found.pose.theta - predicted.theta).abs() > usual.angular;
+            if beyond {
+                answers.push((anchor.to_pose() * found.pose.to_pose(), found.score, i, found));
+            }
+        }
+        answers.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.2.cmp(&b.2)));
+        self.relocalising.retain(|r| travel - r.0 <= CONSISTENT_WINDOW);
+        // The best answer the earlier searches agree with: the move it makes of the graph moves their nodes onto
+        // one of their answers.
+        let agreed = answers.iter().find(|(at, ..)| {
+            let correction = at * node.inverse();
+            let agreeing: Vec<f64> = self
+                .relocalising
+                .iter()
+                .filter(|(_, earlier, found)| {
+                    let moved = Xyt::from_pose(&(correction * earlier));
+                    found.iter().any(|f| {
+                        let f = Xyt::from_pose(f);
+                        (f.x - moved.x).hypot(f.y - moved.y) <= RELOCALISE_AGREE_M
+                            && mrslam_core::pose::normalize_angle(f.theta - moved.theta).abs() <= RELOCALISE_AGREE_RAD
+                    })
+                })
+                .map(|r| r.0)
+                .collect();
+            let first = agreeing.iter().copied().fold(travel, f64::min);
+            agreeing.len() + 1 >= CONSISTENT_RIVALLED && travel - first >= CONSISTENT_TRAVEL
+        });
+        let kept = agreed.and_then(|&(_, _, i, found)| {
+            let s = self.submaps[i];
+            let grids = self.grids(i)?;
+            let edge = refine_to_edge(&grids, &self.matcher, scan, &found, &self.params, (s.first, k))?;
+            Some(self.held_from_nearest_node(edge, s))
+        });
+        self.relocalising.push((travel, node, answers.iter().map(|a| a.0).collect()));
+        match kept {
+            Some(edge) => {
+                // Agreed over metres of driving: no robust kernel, which would let the graph keep most of its error.
+                self.loops.push(Edge { huber: f64::INFINITY, ..edge });
+                self.relocalised_now = true;
+                self.pending += 1;
+                self.report.closures += 1;
+                self.report.relocalised += 1;
+                self.lost = None;
+                self.relocalising.clear();
+                self.contradicted.clear();
+                true
+            }
+            None => {
+                if self.lost.is_some_and(|start| travel - start > RELOCALISE_GIVE_UP) {
+                    self.lost = None;
+                    self.relocalising.clear();
+                }
+                false
+            }
+        }
+    }
+
+    /// Submap `i`'s search grids at the graph's version (built and cached when not cached).
+    fn grids(&mut self, i: usize) -> Option<Arc<SubmapGrids>> {
+        if let Some(g) = self.cache.get(i, self.version) {
+            return Some(g);
+        }
+        let s = self.submaps[i];
+        let anchor = self.nodes[s.first].pose;
+        let poses: Vec<Xyt> = (s.first..=s.last).map(|n| self.nodes[n].pose).collect();
+        let local = in_anchor_frame(&anchor, &poses);
+        let prepared: Vec<PreparedScan> = (s.first..=s.last).map(|n| self.prepare(&self.nodes[n].scan)).collect();
+        let scans: Vec<(Xyt, &PreparedScan)> = local.into_iter().zip(&prepared).collect();
+        let g = Arc::new(SubmapGrids::build(&scans, &self.matcher, self.map.delta, PYRAMID_DEPTH)?);
+        self.cache.put(i, self.version, g.clone());
+        Some(g)
     }
 
     /// Judges the map the graph holds: every node against the submaps near it that it is at least a loop's
@@ -362,13 +543,8 @@ impl LoopGraph {
         // Each judged node's most contradicted judgement: (contradicting, seen).
         let mut worst: Vec<Option<(usize, usize)>> = vec![None; self.nodes.len()];
         for group in pairs.chunk_by(|a, b| a.0 == b.0) {
-            let s = self.submaps[group[0].0];
-            let anchor = self.nodes[s.first].pose;
-            let poses: Vec<Xyt> = (s.first..=s.last).map(|n| self.nodes[n].pose).collect();
-            let prepared: Vec<PreparedScan> = (s.first..=s.last).map(|n| self.prepare(&self.nodes[n].scan)).collect();
-            let scans: Vec<(Xyt, &PreparedScan)> =
-                in_anchor_frame(&anchor, &poses).into_iter().zip(&prepared).collect();
-            let Some(space) = FreeSpace::build(&scans, &self.matcher, cell) else { continue };
+            let anchor = self.nodes[self.submaps[group[0].0].first].pose;
+            let Some(space) = self.free_space_of(group[0].0) else { continue };
             for &(_, k) in group {
                 let scan = self.prepare(&self.nodes[k].scan);
                 let at = in_anchor_frame(&anchor, &[self.nodes[k].pose])[0];
@@ -649,6 +825,23 @@ mod tests {
         let (worst, _) = error_to(&truth, history.last().unwrap());
         assert!(worst < 0.03, "the graph moved a true pose {worst} m");
         assert!(report.judged >= 5 && report.contradicted == 0, "{report:?}");
+    }
+
+    #[test]
+    fn a_lap_kinked_beyond_the_windows_is_placed_by_a_search_against_every_submap() {
+        // A turn of 0.45 rad three quarters round the lap, as when the odometry missed a turn in a gap of the data:
+        // the lap's end comes back 5 m from its start, beyond the loop search's windows.
+        let (truth, _, _) = office_nodes();
+        let at = 3 * truth.len() / 4;
+        let kink = move |k: usize| if k == at { 0.45 } else { 0.0 };
+        let windows_only = LoopClosureParams { relocalise: false, ..crate::SlamParams::matched().loop_closure };
+        let (truth, history, report) = drive_turning(kink, windows_only);
+        let (_, end) = error_to(&truth, history.last().unwrap());
+        assert!(end > 3.0 && report.closures == 0 && report.contradicts_itself(), "{end} m, {report:?}");
+        let (truth, history, report) = drive_turning(kink, crate::SlamParams::matched().loop_closure);
+        let (_, end) = error_to(&truth, history.last().unwrap());
+        assert!(report.relocalised >= 1 && report.closures > report.relocalised, "{report:?}");
+        assert!(end < 0.3 && !report.contradicts_itself(), "the lap's end {end} m from the truth, {report:?}");
     }
 
     /// Where the kinked lap turns wrong (quarters of the lap) and by how much, radians.

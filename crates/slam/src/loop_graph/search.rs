@@ -19,8 +19,8 @@ pub struct SearchWindow {
     pub angular: f64,
 }
 
-/// Headings searched at most on each side of the predicted one (the step widens beyond).
-const MAX_HEADING_STEPS: usize = 200;
+/// Headings searched at most on each side of the predicted one by a loop search (the step widens beyond).
+pub const MAX_HEADING_STEPS: usize = 200;
 /// Points of a scan the branch and bound places at most.
 const MAX_POINTS: usize = 400;
 
@@ -58,14 +58,15 @@ pub fn search_points(scan: &PreparedScan, matcher: &ScanMatcher, cell: f64) -> V
     cells.iter().step_by(stride).map(|&(_, _, x, y)| (x, y)).collect()
 }
 
-/// Branch and bound of `points` (robot frame) on `grids` over `window` around `predicted` (submap frame):
-/// the best pose whose mean score reaches `min_score`, or `None`.
+/// Branch and bound of `points` (robot frame) on `grids` over `window` around `predicted` (submap frame), at
+/// most `max_steps` headings on each side: the best pose whose mean score reaches `min_score`, or `None`.
 pub fn branch_and_bound_pose(
     grids: &SubmapGrids,
     points: &[(f64, f64)],
     predicted: &Xyt,
     window: SearchWindow,
     min_score: f64,
+    max_steps: usize,
 ) -> Option<Found> {
     if points.is_empty() {
         return None;
@@ -74,7 +75,7 @@ pub fn branch_and_bound_pose(
     let reach = points.iter().map(|&(x, y)| x.hypot(y)).fold(cell, f64::max);
     // The heading step that moves the farthest point by about a cell.
     let fine = (1.0 - cell * cell / (2.0 * reach * reach)).clamp(-1.0, 1.0).acos().max(1e-4);
-    let steps = ((window.angular / fine).ceil() as usize).min(MAX_HEADING_STEPS);
+    let steps = ((window.angular / fine).ceil() as usize).min(max_steps);
     let step = if steps > 0 { window.angular / steps as f64 } else { 0.0 };
     let (cx, cy) = ((predicted.x - grids.origin.0) / cell, (predicted.y - grids.origin.1) / cell);
     let half = (window.linear / cell).ceil() as i32;
