@@ -26,13 +26,16 @@ done
 python3 - "$out" estimate "${lags[@]/#/lag}" <<'PY'
 import json, sys
 out, names = sys.argv[1], sys.argv[2:]
-print("| lag (s) | translation (m) | max (m) | rotation (deg) | loop edges kept | loops left open |")
-print("|---|---|---|---|---|---|")
+print("| lag (s) | translation (m) | max (m) | rotation (deg) | loop edges kept | loops left open "
+      "| contradicted / judged | searches everywhere (kept) |")
+print("|---|---|---|---|---|---|---|---|")
 for name in names:
     s = json.load(open(f"{out}/{name}.json"))
     m, l, lag = s["metric"], s["loop_closure"] or {}, s["line_odometry_lag"] or {}
     used = lag.get("used_s", 0.0)
     label = f"{used:.3f} (estimate)" if name == "estimate" else f"{used:.3f}"
     print(f"| {label} | {m['translation_mean_m']:.4f} | {m['translation_max_m']:.2f} | {m['rotation_mean_deg']:.3f} "
-          f"| {l.get('closures', '-')} | {l.get('open_loops', '-')} |")
+          f"| {l.get('closures', '-')} | {l.get('open_loops', '-')} "
+          f"| {l.get('contradicted', '-')} / {l.get('judged', '-')}{' **flagged**' if l.get('contradicts_itself') else ''} "
+          f"| {l.get('relocalisations', '-')} ({l.get('relocalised', '-')}) |")
 PY
