@@ -39,11 +39,8 @@ const JUDGE_WINDOW: SearchWindow = SearchWindow { linear: 0.5, angular: 0.01 };
 impl LoopGraph {
     /// Submap `i`'s free space, drawn from its nodes' poses now, in its anchor's frame.
     pub(super) fn free_space_of(&self, i: usize) -> Option<FreeSpace> {
-        let s = self.submaps[i];
-        let anchor = self.nodes[s.first].pose;
-        let poses: Vec<Xyt> = (s.first..=s.last).map(|n| self.nodes[n].pose).collect();
-        let prepared: Vec<PreparedScan> = (s.first..=s.last).map(|n| self.prepare(&self.nodes[n].scan)).collect();
-        let scans: Vec<(Xyt, &PreparedScan)> = in_anchor_frame(&anchor, &poses).into_iter().zip(&prepared).collect();
+        let (local, prepared) = self.submap_scans(i);
+        let scans: Vec<(Xyt, &PreparedScan)> = local.into_iter().zip(&prepared).collect();
         FreeSpace::build(&scans, &self.matcher, self.map.delta * submap::COARSE as f64)
     }
 
@@ -90,6 +87,7 @@ impl LoopGraph {
         let node = self.nodes[k].pose.to_pose();
         // Every submap's best answer: where it puts the node (map frame), its score, the submap and the answer.
         let mut answers: Vec<(mrslam_core::Pose2, f64, usize, search::Found)> = Vec::new();
+        let points = search_points(scan, &self.matcher, self.map.delta * submap::COARSE as f64);
         for i in 0..self.submaps.len() {
             let s = self.submaps[i];
             if travel - self.travel[s.last] < self.params.min_travel {
@@ -106,7 +104,6 @@ impl LoopGraph {
                 linear: 0.5 * (x1 - x0).hypot(y1 - y0) + self.params.search_radius,
                 angular: std::f64::consts::PI,
             };
-            let points = search_points(scan, &self.matcher, grids.cell);
             let steps = RELOCALISE_HEADING_STEPS;
             let Some(found) = branch_and_bound_pose(&grids, &points, &centre, window, self.params.min_score, steps)
             else {

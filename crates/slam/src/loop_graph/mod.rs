@@ -346,16 +346,20 @@ impl LoopGraph {
         Some(self.held_from_nearest_node(edge, s))
     }
 
+    /// Submap `i`'s nodes' poses in its anchor's frame, and their scans prepared for loop matching.
+    fn submap_scans(&self, i: usize) -> (Vec<Xyt>, Vec<PreparedScan>) {
+        let s = self.submaps[i];
+        let poses: Vec<Xyt> = (s.first..=s.last).map(|n| self.nodes[n].pose).collect();
+        let prepared = (s.first..=s.last).map(|n| self.prepare(&self.nodes[n].scan)).collect();
+        (in_anchor_frame(&self.nodes[s.first].pose, &poses), prepared)
+    }
+
     /// Submap `i`'s search grids at the graph's version (built and cached when not cached).
     fn grids(&mut self, i: usize) -> Option<Arc<SubmapGrids>> {
         if let Some(g) = self.cache.get(i, self.version) {
             return Some(g);
         }
-        let s = self.submaps[i];
-        let anchor = self.nodes[s.first].pose;
-        let poses: Vec<Xyt> = (s.first..=s.last).map(|n| self.nodes[n].pose).collect();
-        let local = in_anchor_frame(&anchor, &poses);
-        let prepared: Vec<PreparedScan> = (s.first..=s.last).map(|n| self.prepare(&self.nodes[n].scan)).collect();
+        let (local, prepared) = self.submap_scans(i);
         let scans: Vec<(Xyt, &PreparedScan)> = local.into_iter().zip(&prepared).collect();
         let g = Arc::new(SubmapGrids::build(&scans, &self.matcher, self.map.delta, PYRAMID_DEPTH)?);
         self.cache.put(i, self.version, g.clone());
