@@ -102,7 +102,8 @@ pub struct LoopClosureParams {
     /// `loop_relocalise` (online only): when scans of places passed a loop ago keep seeing walls on the map's open
     /// floor where the graph puts them, the graph is wrong beyond what its windows reach (a turn the odometry
     /// missed in a gap of the data); the scans are then searched against every submap, over the whole submap and
-    /// every heading, and an answer that agrees from node to node becomes a loop edge. Off: the windows only.
+    /// headings within a quarter turn of the graph's, and an answer that agrees from node to node becomes a loop
+    /// edge. Off: the windows only.
     pub relocalise: bool,
 }
 
@@ -154,8 +155,8 @@ pub struct LoopClosureReport {
     /// Stretches of at least `loop_open_travel` metres through places passed a loop ago in which no loop edge
     /// was found (online only): a map with such a stretch may show a place twice.
     pub open_loops: usize,
-    /// Searches of a scan against every submap over every heading, made after scans contradicted the map where
-    /// the graph put them (online only).
+    /// Searches of a scan against every submap (within a quarter turn of the graph's heading), made after scans
+    /// contradicted the map where the graph put them (online only).
     pub relocalisations: usize,
     /// Loop edges those searches kept (also counted in `closures`).
     pub relocalised: usize,

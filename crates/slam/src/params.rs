@@ -159,6 +159,7 @@ pub const FLAT_NAMES: &[(&str, &str)] = &[
     ("scan_odometry_turn_round", "scan_odometry.turn_round"),
     ("scan_odometry_line_lag", "scan_odometry.line_lag"),
     ("scan_odometry_line_lag_s", "scan_odometry.line_lag_s"),
+    ("scan_odometry_prior", "scan_odometry.prior"),
     ("loop_closure", "loop_closure.enabled"),
     ("loop_min_travel", "loop_closure.min_travel"),
     ("loop_search_radius", "loop_closure.search_radius"),
@@ -383,6 +384,7 @@ impl SlamParams {
         pos("scan_odometry.range", so.range)?;
         pos("scan_odometry.sigma", so.sigma)?;
         nonneg("scan_odometry.heading_search", so.heading_search)?;
+        nonneg("scan_odometry.prior", so.prior)?;
         if so.line_lag_s.is_nan() || so.line_lag_s.abs() > 1.0 {
             return invalid("scan_odometry.line_lag_s", format!("must be within ±1 s, got {}", so.line_lag_s));
         }

@@ -87,6 +87,9 @@ pub struct ScanOdometryParams {
     /// estimated one (positive: the odometry is late), when `line_lag` is on; 0 (the default): estimate it.
     /// For a user who knows the lag, and to measure how a map depends on it.
     pub line_lag_s: f64,
+    /// `scan_odometry_prior`: the weight of the prior on the odometry's increment (1, the default: GMapping's noise
+    /// model over the increment, with floors; 0: the scans alone).
+    pub prior: f64,
 }
 
 impl Default for ScanOdometryParams {
@@ -101,6 +104,7 @@ impl Default for ScanOdometryParams {
             turn_round: true,
             line_lag: true,
             line_lag_s: 0.0,
+            prior: 1.0,
         }
     }
 }
@@ -155,7 +159,7 @@ impl ScanOdometry {
         let matcher_params = MatcherParams {
             sigma: so.sigma,
             heading_search: so.heading_search,
-            motion_prior: 1.0,
+            motion_prior: so.prior,
             field_reach: so.reach,
             ..matcher.alone()
         };

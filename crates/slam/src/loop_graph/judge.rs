@@ -5,8 +5,8 @@
 //! every place the robot comes back to lies beyond them. A processed scan that found no loop edge is judged
 //! against the nearest submap passed a loop ago ([`super::free_space`]); [`RELOCALISE_AFTER`] contradicted scans
 //! within [`RELOCALISE_TRAVEL`] metres start a search of each following node against every submap, over the whole
-//! submap and every heading, whose answers must agree from node to node. At the end of the data every node is
-//! judged so, and the report counts the contradicted ones
+//! submap and headings within a quarter turn of the graph's, whose answers must agree from node to node. At the end
+//! of the data every node is judged so, and the report counts the contradicted ones
 //! ([`crate::LoopClosureReport::contradicts_itself`]).
 
 use super::free_space::FreeSpace;
@@ -31,8 +31,13 @@ const RELOCALISE_GIVE_UP: f64 = 20.0;
 /// How closely two answers of searches everywhere must move the graph alike, metres and radians.
 const RELOCALISE_AGREE_M: f64 = 0.3;
 const RELOCALISE_AGREE_RAD: f64 = 0.05;
-/// Headings on each side of the predicted one a search against a whole submap tries at most (every turn).
+/// Headings on each side of the predicted one a search against a whole submap tries at most.
 const RELOCALISE_HEADING_STEPS: usize = 1000;
+/// The most a search against a whole submap turns the node from where the graph has it, radians: a corridor
+/// matches turned round about as well as the right way, and its answers agree from node to node turned round too
+/// (ACES with a looser scan-odometry prior: three such edges kept, turning the graph 1.05-3.12 rad, 0.21 -> 0.97 m);
+/// the turns a robot's odometry missed in a gap of the data are smaller (ACES's stale scan line: 1.0 rad).
+const RELOCALISE_MAX_TURN: f64 = std::f64::consts::FRAC_PI_2;
 /// How far a scan may be from where the graph puts it in a good map when its map is judged.
 const JUDGE_WINDOW: SearchWindow = SearchWindow { linear: 0.5, angular: 0.01 };
 
@@ -76,11 +81,11 @@ impl LoopGraph {
         self.lost.get_or_insert(travel);
     }
 
-    /// Searches node `k` against every finished submap passed a loop ago, over the whole submap and every heading.
-    /// An answer is kept as a loop edge when the answers of earlier such searches, at least
-    /// [`CONSISTENT_RIVALLED`] - 1 of them over [`CONSISTENT_TRAVEL`] metres of driving, move the graph alike (a scan
-    /// along a corridor matches many places of it; the true one agrees from node to node). Returns whether one was
-    /// kept.
+    /// Searches node `k` against every finished submap passed a loop ago, over the whole submap and headings within
+    /// [`RELOCALISE_MAX_TURN`] of the graph's. An answer is kept as a loop edge when the answers of earlier such
+    /// searches, at least [`CONSISTENT_RIVALLED`] - 1 of them over [`CONSISTENT_TRAVEL`] metres of driving, move the
+    /// graph alike (a scan along a corridor matches many places of it; the true one agrees from node to node).
+    /// Returns whether one was kept.
     pub(super) fn relocalise(&mut self, k: usize, scan: &PreparedScan) -> bool {
         self.report.relocalisations += 1;
         let travel = self.travel[k];
@@ -102,7 +107,7 @@ impl LoopGraph {
             let centre = Xyt { x: 0.5 * (x0 + x1), y: 0.5 * (y0 + y1), theta: predicted.theta };
             let window = SearchWindow {
                 linear: 0.5 * (x1 - x0).hypot(y1 - y0) + self.params.search_radius,
-                angular: std::f64::consts::PI,
+                angular: RELOCALISE_MAX_TURN,
             };
             let steps = RELOCALISE_HEADING_STEPS;
             let Some(found) = branch_and_bound_pose(&grids, &points, &centre, window, self.params.min_score, steps)
