@@ -652,9 +652,9 @@ mod tests {
 
     #[test]
     fn a_search_against_every_submap_does_not_turn_the_graph_round() {
-        // The lap turned 1.7 rad near its end, beyond a quarter turn, where a corridor's answers turned round agree
-        // from node to node as well as the right ones: the scans are searched against every submap, no answer is
-        // kept (every heading searched, one was), and the map is flagged.
+        // The lap turned 1.7 rad near its end, more than a quarter turn (a corridor's answers turned round agree from
+        // node to node as well as the right ones): the scans are searched against every submap, but no answer that
+        // turns the graph that far is kept (searched over every heading, one was), and the map is left to the flag.
         let (truth, _, _) = office_nodes();
         let at = 85 * truth.len() / 100;
         let (_, _, report) =
