@@ -384,7 +384,7 @@ impl SlamParams {
         pos("scan_odometry.range", so.range)?;
         pos("scan_odometry.sigma", so.sigma)?;
         nonneg("scan_odometry.heading_search", so.heading_search)?;
-        nonneg("scan_odometry.prior", so.prior)?;
+        pos("scan_odometry.prior", so.prior)?;
         if so.line_lag_s.is_nan() || so.line_lag_s.abs() > 1.0 {
             return invalid("scan_odometry.line_lag_s", format!("must be within ±1 s, got {}", so.line_lag_s));
         }
