@@ -141,8 +141,8 @@ pub struct ScanOdometry {
     pose: Xyt,
     /// GMapping's noise model, for the prior.
     noise: MotionModel,
-    /// The weight of the prior's translation ([`ScanOdometryParams::prior`]).
-    prior_t: f64,
+    /// What the prior's translation sigmas are multiplied by: 1/√[`ScanOdometryParams::prior`].
+    translation_scale: f64,
     /// Scans inserted so far.
     inserted: usize,
     turn_round: bool,
@@ -178,7 +178,7 @@ impl ScanOdometry {
             last_raw: None,
             pose: Xyt { x: 0.0, y: 0.0, theta: 0.0 },
             noise,
-            prior_t: so.prior,
+            translation_scale: 1.0 / so.prior.sqrt(),
             inserted: 0,
             turn_round: so.turn_round,
             matched: 0,
@@ -239,8 +239,8 @@ impl ScanOdometry {
         let predicted = self.predict((dx, dy, dt));
         let [sx, sy, st] = self.noise.sigmas(dx, dy, dt);
         let prior = MotionPrior {
-            sx: sx.max(MIN_PRIOR_SIGMA[0]) / self.prior_t.sqrt(),
-            sy: sy.max(MIN_PRIOR_SIGMA[1]) / self.prior_t.sqrt(),
+            sx: sx.max(MIN_PRIOR_SIGMA[0]) * self.translation_scale,
+            sy: sy.max(MIN_PRIOR_SIGMA[1]) * self.translation_scale,
             st: st.max(MIN_PRIOR_SIGMA[2]),
         };
         let mut scratch = SCRATCH.take();

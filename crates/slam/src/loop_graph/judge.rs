@@ -42,11 +42,16 @@ const RELOCALISE_MAX_TURN: f64 = std::f64::consts::FRAC_PI_2;
 const JUDGE_WINDOW: SearchWindow = SearchWindow { linear: 0.5, angular: 0.01 };
 
 impl LoopGraph {
+    /// The cell of the submaps' search grids and free space, metres.
+    fn coarse_cell(&self) -> f64 {
+        self.map.delta * submap::COARSE as f64
+    }
+
     /// Submap `i`'s free space, drawn from its nodes' poses now, in its anchor's frame.
     pub(super) fn free_space_of(&self, i: usize) -> Option<FreeSpace> {
         let (local, prepared) = self.submap_scans(i);
         let scans: Vec<(Xyt, &PreparedScan)> = local.into_iter().zip(&prepared).collect();
-        FreeSpace::build(&scans, &self.matcher, self.map.delta * submap::COARSE as f64)
+        FreeSpace::build(&scans, &self.matcher, self.coarse_cell())
     }
 
     /// Judges node `k`, whose searches found no loop edge, against submap `i` beside it. After
@@ -66,8 +71,7 @@ impl LoopGraph {
         };
         let anchor = self.nodes[self.submaps[i].first].pose;
         let at = in_anchor_frame(&anchor, &[self.nodes[k].pose])[0];
-        let cell = self.map.delta * submap::COARSE as f64;
-        let j = space.judge(&search_points(scan, &self.matcher, cell), &at, JUDGE_WINDOW);
+        let j = space.judge(&search_points(scan, &self.matcher, self.coarse_cell()), &at, JUDGE_WINDOW);
         if !(j.seen >= MIN_SEEN && j.contradicting as f64 >= CONTRADICTING_SHARE * j.seen as f64) {
             return;
         }
@@ -92,7 +96,7 @@ impl LoopGraph {
         let node = self.nodes[k].pose.to_pose();
         // Every submap's best answer: where it puts the node (map frame), its score, the submap and the answer.
         let mut answers: Vec<(mrslam_core::Pose2, f64, usize, search::Found)> = Vec::new();
-        let points = search_points(scan, &self.matcher, self.map.delta * submap::COARSE as f64);
+        let points = search_points(scan, &self.matcher, self.coarse_cell());
         for i in 0..self.submaps.len() {
             let s = self.submaps[i];
             if travel - self.travel[s.last] < self.params.min_travel {
@@ -178,7 +182,7 @@ impl LoopGraph {
     /// Judges the map the graph holds: every node against the submaps near it that it is at least a loop's
     /// driving away from ([`super::free_space`]); counts the nodes whose scan sees surfaces on a submap's open floor.
     pub(super) fn judge_map(&mut self) {
-        let cell = self.map.delta * submap::COARSE as f64;
+        let cell = self.coarse_cell();
         // The submaps each node is judged against, as (submap, node) pairs by submap: one free-space grid at a time.
         let mut pairs: Vec<(usize, usize)> = Vec::new();
         for (k, node) in self.nodes.iter().enumerate() {
